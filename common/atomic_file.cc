@@ -1,0 +1,114 @@
+#include "common/atomic_file.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <set>
+
+#include "common/error.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::mutex& StagingMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+std::set<std::string>& StagingSet() {
+  static std::set<std::string> dirs;
+  return dirs;
+}
+
+}  // namespace
+
+void AtomicWriteFile(const fs::path& path, std::string_view bytes) {
+  const fs::path tmp = path.parent_path() /
+                       ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
+  {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (f == nullptr) throw RuntimeError("cannot write " + tmp.string());
+    const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), f);
+    const bool ok = written == bytes.size() && std::fclose(f) == 0;
+    if (!ok) {
+      std::remove(tmp.c_str());
+      throw RuntimeError("write failed (disk full?): " + path.string());
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw RuntimeError("cannot rename into " + path.string() + ": " + ec.message());
+  }
+}
+
+StagingDir::StagingDir(const fs::path& final_path, bool overwrite, const std::string& option)
+    : final_path_(fs::absolute(final_path).lexically_normal()) {
+  if (final_path_.filename().empty()) final_path_ = final_path_.parent_path();
+  const fs::path parent = final_path_.parent_path();
+  if (!fs::is_directory(parent)) {
+    throw InputError("", option, "parent folder '" + parent.string() + "' does not exist");
+  }
+  if (fs::exists(final_path_) && !overwrite) {
+    throw InputError("", option,
+                     "'" + final_path_.string() + "' exists (pass --force to replace it)");
+  }
+  staging_path_ =
+      parent / ("." + final_path_.filename().string() + ".partial-" + std::to_string(getpid()));
+  std::error_code ec;
+  fs::remove_all(staging_path_, ec);
+  if (!fs::create_directory(staging_path_, ec) || ec) {
+    throw RuntimeError("cannot create " + staging_path_.string() + ": " + ec.message());
+  }
+  std::lock_guard lock(StagingMutex());
+  StagingSet().insert(staging_path_.string());
+}
+
+StagingDir::~StagingDir() {
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove_all(staging_path_, ec);
+  }
+  std::lock_guard lock(StagingMutex());
+  StagingSet().erase(staging_path_.string());
+}
+
+void StagingDir::Commit() {
+  std::error_code ec;
+  fs::path old;
+  if (fs::exists(final_path_)) {
+    old = final_path_.parent_path() /
+          ("." + final_path_.filename().string() + ".old-" + std::to_string(getpid()));
+    fs::remove_all(old, ec);
+    fs::rename(final_path_, old, ec);
+    if (ec) throw RuntimeError("cannot move old " + final_path_.string() + " aside: " + ec.message());
+  }
+  fs::rename(staging_path_, final_path_, ec);
+  if (ec) throw RuntimeError("cannot rename into " + final_path_.string() + ": " + ec.message());
+  committed_ = true;
+  if (!old.empty()) fs::remove_all(old, ec);
+}
+
+void RemoveStagingDirsOfThisProcess() {
+  // Called from normal code paths after a cancel; not async-signal-safe.
+  std::lock_guard lock(StagingMutex());
+  for (const std::string& dir : StagingSet()) {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+}
+
+uint64_t Fnv1a64(std::string_view bytes, uint64_t seed) {
+  uint64_t hash = seed;
+  for (unsigned char c : bytes) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+}  // namespace irbench

@@ -1,0 +1,28 @@
+#pragma once
+// Camera rigs (rigs/*.json): per camera resolution, intrinsics, distortion, a
+// pose as position + look-at + up, fps and exposure. Format in docs/formats.md.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sim/camera/camera.h"
+
+namespace irbench {
+
+struct Rig {
+  std::string name;
+  std::string scene;  // the scene the rig was designed for (default for --scene)
+  std::vector<Camera> cameras;
+  std::filesystem::path source;
+};
+
+// Loads and validates a rig; every problem throws InputError naming the file and
+// field (e.g. "cameras[1].fx: must be positive").
+Rig LoadRig(const std::filesystem::path& path);
+
+// Checks that the distortion does not fold inside the image and that every
+// border pixel undistorts. Returns an error message or "".
+std::string CheckDistortionUsable(const Camera& camera);
+
+}  // namespace irbench

@@ -1,0 +1,101 @@
+// EGL headless context: Mesa's surfaceless platform (or a device platform on a
+// vendor driver), OpenGL core profile, no window system.
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+
+#include "common/error.h"
+#include "sim/gl/gl_context.h"
+
+namespace irbench {
+namespace {
+
+std::string EglErrorString(EGLint error) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "0x%04x", static_cast<unsigned>(error));
+  return buffer;
+}
+
+class EglHeadlessContext final : public GlContext {
+ public:
+  EglHeadlessContext() {
+    auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+        eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (get_platform_display == nullptr) {
+      throw RuntimeError("eglGetPlatformDisplayEXT is missing (no EGL_EXT_platform_base)");
+    }
+    // Surfaceless first (Mesa); then the default device platform (vendor EGL).
+    display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0, minor = 0;
+    if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
+      // A vendor driver: the first EGL device.
+      auto query_devices =
+          reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+      EGLDeviceEXT device = nullptr;
+      EGLint num_devices = 0;
+      display_ = EGL_NO_DISPLAY;
+      if (query_devices != nullptr && query_devices(1, &device, &num_devices) && num_devices > 0) {
+        display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
+      }
+      if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
+        throw RuntimeError("eglInitialize failed: " + EglErrorString(eglGetError()));
+      }
+    }
+    const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE,
+                                     EGL_PBUFFER_BIT, EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint num_configs = 0;
+    if (!eglChooseConfig(display_, config_attribs, &config, 1, &num_configs) || num_configs == 0) {
+      // Surfaceless displays may offer configs without pbuffer support.
+      const EGLint any_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+      if (!eglChooseConfig(display_, any_attribs, &config, 1, &num_configs) || num_configs == 0) {
+        eglTerminate(display_);
+        throw RuntimeError("no EGL config with OpenGL");
+      }
+    }
+    if (!eglBindAPI(EGL_OPENGL_API)) {
+      eglTerminate(display_);
+      throw RuntimeError("eglBindAPI(EGL_OPENGL_API) failed");
+    }
+    for (auto [maj, min] : {std::pair{4, 5}, std::pair{3, 3}}) {
+      const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, maj,
+                                        EGL_CONTEXT_MINOR_VERSION, min,
+                                        EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+      context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, context_attribs);
+      if (context_ != EGL_NO_CONTEXT) break;
+    }
+    if (context_ == EGL_NO_CONTEXT) {
+      const EGLint error = eglGetError();
+      eglTerminate(display_);
+      throw RuntimeError("eglCreateContext (core 3.3+) failed: " + EglErrorString(error));
+    }
+    if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
+      const EGLint error = eglGetError();
+      eglDestroyContext(display_, context_);
+      eglTerminate(display_);
+      throw RuntimeError("eglMakeCurrent (surfaceless) failed: " + EglErrorString(error));
+    }
+    gl_.Load([](const char* name) { return reinterpret_cast<void*>(eglGetProcAddress(name)); });
+  }
+
+  ~EglHeadlessContext() override {
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(display_, context_);
+    eglTerminate(display_);
+  }
+
+  std::string BackendName() const override { return "egl"; }
+
+ private:
+  EGLDisplay display_ = EGL_NO_DISPLAY;
+  EGLContext context_ = EGL_NO_CONTEXT;
+};
+
+}  // namespace
+
+std::unique_ptr<GlContext> CreateEglHeadlessContext() {
+  return std::make_unique<EglHeadlessContext>();
+}
+
+}  // namespace irbench

@@ -1,0 +1,40 @@
+#pragma once
+// Headless OpenGL behind one interface. Backends:
+//   egl    - EGL on Mesa's surfaceless platform (llvmpipe here; a vendor EGL
+//            where a GPU exists), the primary path;
+//   osmesa - Mesa's off-screen library, from its own module;
+//   auto   - egl, falling back to osmesa.
+// Contexts are OpenGL 3.3 core (or newer); all rendering goes into FBOs.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "sim/gl/gl_functions.h"
+
+namespace irbench {
+
+enum class GlBackend { kAuto, kEgl, kOsMesa };
+
+// Parses "auto" | "egl" | "osmesa"; nullopt otherwise.
+std::optional<GlBackend> ParseGlBackend(const std::string& name);
+
+class GlContext {
+ public:
+  virtual ~GlContext() = default;
+  // "egl" or "osmesa".
+  virtual std::string BackendName() const = 0;
+  const GlFunctions& gl() const { return gl_; }
+  // GL_RENDERER and GL_VERSION strings.
+  std::string RendererString() const;
+
+ protected:
+  GlFunctions gl_;
+};
+
+
+// Creates and makes current a context; throws RuntimeError with the reasons of
+// every backend tried.
+std::unique_ptr<GlContext> CreateGlContext(GlBackend backend);
+
+}  // namespace irbench

@@ -1,0 +1,402 @@
+#include "sim/render/renderer.h"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "common/error.h"
+
+namespace irbench {
+namespace {
+
+constexpr const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_material;  // albedo, emissive
+uniform mat4 u_clip_from_world;
+uniform mat4 u_cam_from_world;
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_material;
+out float v_depth;
+void main() {
+  vec4 p = vec4(a_position, 1.0);
+  gl_Position = u_clip_from_world * p;
+  v_world = a_position;
+  v_normal = a_normal;
+  v_material = a_material;
+  v_depth = (u_cam_from_world * p).z;
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 330 core
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_material;
+in float v_depth;
+uniform float u_person;
+uniform vec3 u_camera_center;
+uniform float u_ambient;
+uniform int u_light_count;
+uniform vec3 u_light_position[8];
+uniform vec3 u_light_direction[8];
+uniform float u_light_cos_half[8];
+uniform float u_light_power[8];
+layout(location = 0) out float o_grey;
+layout(location = 1) out float o_mask;
+layout(location = 2) out float o_depth;
+void main() {
+  vec3 n = normalize(v_normal);
+  if (dot(n, u_camera_center - v_world) < 0.0) n = -n;  // two-sided
+  float radiance;
+  if (v_material.y > 0.5) {
+    radiance = v_material.x;
+  } else {
+    float irradiance = u_ambient;
+    for (int i = 0; i < u_light_count; ++i) {
+      vec3 to_light = u_light_position[i] - v_world;
+      float d2 = max(dot(to_light, to_light), 0.25);
+      vec3 l = to_light * inversesqrt(dot(to_light, to_light));
+      float c = dot(-l, u_light_direction[i]);
+      float cone = smoothstep(u_light_cos_half[i] - 0.05, u_light_cos_half[i] + 0.05, c);
+      irradiance += u_light_power[i] * cone * max(dot(n, l), 0.0) / d2;
+    }
+    radiance = v_material.x * irradiance;
+  }
+  o_grey = clamp(radiance, 0.0, 1.0);
+  o_mask = u_person;
+  o_depth = v_depth;
+}
+)";
+
+unsigned CompileShader(const GlFunctions& gl, GLenum type, const char* source) {
+  const unsigned shader = gl.CreateShader(type);
+  gl.ShaderSource(shader, 1, &source, nullptr);
+  gl.CompileShader(shader);
+  GLint ok = 0;
+  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    gl.GetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    throw RuntimeError(std::string("shader compilation failed: ") + log);
+  }
+  return shader;
+}
+
+// clip_from_cam for an OpenCV camera (x right, y down, z forward) whose pixel
+// (u, v) centre lands on GL window pixel (u, v), rows in image order: the
+// framebuffer's row 0 is the image's top row, so read-back needs no flip.
+Eigen::Matrix4f ClipFromCam(const Camera& cam, double near_m, double far_m) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  m(0, 0) = 2 * cam.fx / cam.width;
+  m(0, 2) = 2 * (cam.cx + 0.5) / cam.width - 1;
+  m(1, 1) = 2 * cam.fy / cam.height;
+  m(1, 2) = 2 * (cam.cy + 0.5) / cam.height - 1;
+  m(2, 2) = (far_m + near_m) / (far_m - near_m);
+  m(2, 3) = -2 * far_m * near_m / (far_m - near_m);
+  m(3, 2) = 1;
+  return m.cast<float>();
+}
+
+void SetupVertexLayout(const GlFunctions& gl) {
+  const GLsizei stride = sizeof(MeshVertex);
+  gl.EnableVertexAttribArray(0);
+  gl.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
+                         reinterpret_cast<void*>(offsetof(MeshVertex, position)));
+  gl.EnableVertexAttribArray(1);
+  gl.VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                         reinterpret_cast<void*>(offsetof(MeshVertex, normal)));
+  gl.EnableVertexAttribArray(2);
+  gl.VertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
+                         reinterpret_cast<void*>(offsetof(MeshVertex, albedo)));
+}
+
+}  // namespace
+
+void RenderOptions::Check() const {
+  if (supersample < 1 || supersample > 8) throw InputError("", "supersample", "must be in 1..8");
+  if (near_m <= 0 || far_m <= near_m) throw InputError("", "near_m", "need 0 < near < far");
+}
+
+struct Renderer::Target {
+  Camera render_camera;  // the supersampled pinhole actually rasterised
+  unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
+  cv::Mat map_x, map_y;  // output pixel -> render pixel
+  cv::Mat raw_grey, raw_mask, raw_depth;
+  Eigen::Matrix4f clip_from_world;
+};
+
+Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const RenderOptions& options)
+    : context_(context), gl_(context.gl()), cameras_(std::move(cameras)), options_(options) {
+  options_.Check();
+  const GlFunctions& gl = gl_;
+  const unsigned vs = CompileShader(gl, GL_VERTEX_SHADER, kVertexShader);
+  const unsigned fs = CompileShader(gl, GL_FRAGMENT_SHADER, kFragmentShader);
+  program_ = gl.CreateProgram();
+  gl.AttachShader(program_, vs);
+  gl.AttachShader(program_, fs);
+  gl.LinkProgram(program_);
+  GLint ok = 0;
+  gl.GetProgramiv(program_, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    gl.GetProgramInfoLog(program_, sizeof(log), nullptr, log);
+    throw RuntimeError(std::string("shader link failed: ") + log);
+  }
+  gl.DeleteShader(vs);
+  gl.DeleteShader(fs);
+  gl.UseProgram(program_);
+  SetLighting({}, 1.0);
+
+  const int s = options_.supersample;
+  for (const Camera& cam : cameras_) {
+    auto target = std::make_unique<Target>();
+    // Extent of the undistorted image of the output border, in output pixels.
+    double u_min = 1e9, u_max = -1e9, v_min = 1e9, v_max = -1e9;
+    auto extend = [&](double u, double v) {
+      const auto x_u = cam.Undistort({(u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy});
+      if (!x_u) throw InputError("", "cameras." + cam.name + ".dist", "distortion does not invert");
+      const double pu = cam.fx * x_u->x() + cam.cx, pv = cam.fy * x_u->y() + cam.cy;
+      u_min = std::min(u_min, pu), u_max = std::max(u_max, pu);
+      v_min = std::min(v_min, pv), v_max = std::max(v_max, pv);
+    };
+    for (int u = 0; u <= cam.width; ++u) {
+      extend(u - 0.5, -0.5);
+      extend(u - 0.5, cam.height - 0.5);
+    }
+    for (int v = 0; v <= cam.height; ++v) {
+      extend(-0.5, v - 0.5);
+      extend(cam.width - 0.5, v - 0.5);
+    }
+    const double ox = std::floor(u_min) - 1, oy = std::floor(v_min) - 1;
+    const int nx = static_cast<int>(std::ceil(u_max) - ox) + 2;
+    const int ny = static_cast<int>(std::ceil(v_max) - oy) + 2;
+    Camera& rc = target->render_camera;
+    rc = cam;
+    rc.dist = {0, 0, 0, 0, 0};
+    rc.width = nx * s;
+    rc.height = ny * s;
+    rc.fx = cam.fx * s;
+    rc.fy = cam.fy * s;
+    rc.cx = s * (cam.cx - ox + 0.5) - 0.5;
+    rc.cy = s * (cam.cy - oy + 0.5) - 0.5;
+    if (rc.width > 8192 || rc.height > 8192) {
+      throw InputError("", "cameras." + cam.name, "field of view too wide to render");
+    }
+    target->map_x.create(cam.height, cam.width, CV_32FC1);
+    target->map_y.create(cam.height, cam.width, CV_32FC1);
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        const auto x_u = cam.Undistort({(u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy});
+        target->map_x.at<float>(v, u) = static_cast<float>(rc.fx * x_u->x() + rc.cx);
+        target->map_y.at<float>(v, u) = static_cast<float>(rc.fy * x_u->y() + rc.cy);
+      }
+    }
+    target->clip_from_world = ClipFromCam(rc, options_.near_m, options_.far_m) *
+                              cam.cam_from_world.matrix().cast<float>();
+
+    gl.GenFramebuffers(1, &target->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, target->fbo);
+    auto make_texture = [&](unsigned* tex, GLint internal, GLenum format, GLenum type, GLenum slot) {
+      gl.GenTextures(1, tex);
+      gl.BindTexture(GL_TEXTURE_2D, *tex);
+      gl.TexImage2D(GL_TEXTURE_2D, 0, internal, rc.width, rc.height, 0, format, type, nullptr);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      gl.FramebufferTexture2D(GL_FRAMEBUFFER, slot, GL_TEXTURE_2D, *tex, 0);
+    };
+    make_texture(&target->grey_tex, GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT0);
+    make_texture(&target->mask_tex, GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT1);
+    make_texture(&target->depth_tex, GL_R32F, GL_RED, GL_FLOAT, GL_COLOR_ATTACHMENT2);
+    gl.GenRenderbuffers(1, &target->depth_rbo);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, target->depth_rbo);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, rc.width, rc.height);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                               target->depth_rbo);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    gl.DrawBuffers(3, buffers);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw RuntimeError("framebuffer incomplete for camera " + cam.name);
+    }
+    target->raw_grey.create(rc.height, rc.width, CV_8UC1);
+    target->raw_mask.create(rc.height, rc.width, CV_8UC1);
+    target->raw_depth.create(rc.height, rc.width, CV_32FC1);
+    targets_.push_back(std::move(target));
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+
+  for (auto [vao, vbo, ibo] : {std::tuple{&static_vao_, &static_vbo_, &static_ibo_},
+                               std::tuple{&person_vao_, &person_vbo_, &person_ibo_}}) {
+    gl.GenVertexArrays(1, vao);
+    gl.BindVertexArray(*vao);
+    gl.GenBuffers(1, vbo);
+    gl.BindBuffer(GL_ARRAY_BUFFER, *vbo);
+    gl.GenBuffers(1, ibo);
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, *ibo);
+    SetupVertexLayout(gl);
+  }
+  gl.BindVertexArray(0);
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while setting up the renderer");
+}
+
+Renderer::~Renderer() {
+  const GlFunctions& gl = gl_;
+  for (auto& t : targets_) {
+    gl.DeleteFramebuffers(1, &t->fbo);
+    gl.DeleteTextures(1, &t->grey_tex);
+    gl.DeleteTextures(1, &t->mask_tex);
+    gl.DeleteTextures(1, &t->depth_tex);
+    gl.DeleteRenderbuffers(1, &t->depth_rbo);
+  }
+  for (unsigned* b : {&static_vbo_, &static_ibo_, &person_vbo_, &person_ibo_}) gl.DeleteBuffers(1, b);
+  gl.DeleteVertexArrays(1, &static_vao_);
+  gl.DeleteVertexArrays(1, &person_vao_);
+  gl.DeleteProgram(program_);
+}
+
+const Camera& Renderer::RenderCamera(int index) const { return targets_.at(index)->render_camera; }
+
+void Renderer::SetScene(const Scene& scene) {
+  SetStaticMesh(scene.mesh);
+  SetLighting(scene.lights, scene.ambient);
+}
+
+void Renderer::SetStaticMesh(const TriangleMesh& mesh) {
+  const GlFunctions& gl = gl_;
+  gl.BindVertexArray(static_vao_);
+  gl.BindBuffer(GL_ARRAY_BUFFER, static_vbo_);
+  gl.BufferData(GL_ARRAY_BUFFER, mesh.vertices.size() * sizeof(MeshVertex), mesh.vertices.data(),
+                GL_STATIC_DRAW);
+  gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, mesh.indices.size() * sizeof(uint32_t), mesh.indices.data(),
+                GL_STATIC_DRAW);
+  static_index_count_ = static_cast<int>(mesh.indices.size());
+  gl.BindVertexArray(0);
+}
+
+void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
+  const GlFunctions& gl = gl_;
+  gl.UseProgram(program_);
+  const int n = static_cast<int>(std::min<size_t>(lights.size(), 8));
+  gl.Uniform1f(gl.GetUniformLocation(program_, "u_ambient"), static_cast<float>(ambient));
+  gl.Uniform1i(gl.GetUniformLocation(program_, "u_light_count"), n);
+  std::vector<float> pos(24, 0), dir(24, 0), cos_half(8, 1), power(8, 0);
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      pos[3 * i + k] = static_cast<float>(lights[i].position[k]);
+      dir[3 * i + k] = static_cast<float>(lights[i].direction[k]);
+    }
+    cos_half[i] = static_cast<float>(std::cos(lights[i].cone_deg * M_PI / 360.0));
+    power[i] = static_cast<float>(lights[i].power);
+  }
+  gl.Uniform3fv(gl.GetUniformLocation(program_, "u_light_position"), 8, pos.data());
+  gl.Uniform3fv(gl.GetUniformLocation(program_, "u_light_direction"), 8, dir.data());
+  gl.Uniform1fv(gl.GetUniformLocation(program_, "u_light_cos_half"), 8, cos_half.data());
+  gl.Uniform1fv(gl.GetUniformLocation(program_, "u_light_power"), 8, power.data());
+}
+
+void Renderer::SetPersonTopology(const std::vector<uint32_t>& indices, size_t vertex_count) {
+  const GlFunctions& gl = gl_;
+  gl.BindVertexArray(person_vao_);
+  gl.BindBuffer(GL_ARRAY_BUFFER, person_vbo_);
+  gl.BufferData(GL_ARRAY_BUFFER, vertex_count * sizeof(MeshVertex), nullptr, GL_DYNAMIC_DRAW);
+  gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, indices.size() * sizeof(uint32_t), indices.data(),
+                GL_STATIC_DRAW);
+  gl.BindVertexArray(0);
+  person_index_count_ = static_cast<int>(indices.size());
+  person_vertex_count_ = vertex_count;
+}
+
+void Renderer::UpdatePerson(const std::vector<MeshVertex>& vertices) {
+  if (vertices.size() != person_vertex_count_) {
+    throw RuntimeError("person vertex count differs from its topology");
+  }
+  const GlFunctions& gl = gl_;
+  gl.BindBuffer(GL_ARRAY_BUFFER, person_vbo_);
+  gl.BufferSubData(GL_ARRAY_BUFFER, 0, vertices.size() * sizeof(MeshVertex), vertices.data());
+}
+
+void Renderer::Render(int index, CameraImages* out, bool want_depth) {
+  const GlFunctions& gl = gl_;
+  Target& t = *targets_.at(index);
+  const Camera& rc = t.render_camera;
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  gl.Viewport(0, 0, rc.width, rc.height);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  const float zero[4] = {0, 0, 0, 0};
+  const float one = 1.0f;
+  for (int i = 0; i < 3; ++i) gl.ClearBufferfv(GL_COLOR, i, zero);
+  gl.ClearBufferfv(GL_DEPTH, 0, &one);
+  gl.UseProgram(program_);
+  gl.UniformMatrix4fv(gl.GetUniformLocation(program_, "u_clip_from_world"), 1, GL_FALSE,
+                      t.clip_from_world.data());
+  const Eigen::Matrix4f cam_from_world = rc.cam_from_world.matrix().cast<float>();
+  gl.UniformMatrix4fv(gl.GetUniformLocation(program_, "u_cam_from_world"), 1, GL_FALSE,
+                      cam_from_world.data());
+  const Eigen::Vector3f center = rc.CenterInWorld().cast<float>();
+  gl.Uniform3fv(gl.GetUniformLocation(program_, "u_camera_center"), 1, center.data());
+  const GLint person_loc = gl.GetUniformLocation(program_, "u_person");
+  if (static_index_count_ > 0) {
+    gl.Uniform1f(person_loc, 0.0f);
+    gl.BindVertexArray(static_vao_);
+    gl.DrawElements(GL_TRIANGLES, static_index_count_, GL_UNSIGNED_INT, nullptr);
+  }
+  if (person_visible_ && person_index_count_ > 0) {
+    gl.Uniform1f(person_loc, 1.0f);
+    gl.BindVertexArray(person_vao_);
+    gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
+  }
+  gl.BindVertexArray(0);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_UNSIGNED_BYTE, t.raw_grey.data);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_UNSIGNED_BYTE, t.raw_mask.data);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT2);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_FLOAT, t.raw_depth.data);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while rendering");
+
+  // Resample through the distortion. Grey: bilinear over the supersampled
+  // image (a box filter when undistorted); mask: coverage >= 50%; depth: nearest.
+  cv::remap(t.raw_grey, out->grey, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::Mat coverage;
+  cv::remap(t.raw_mask, coverage, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::threshold(coverage, out->mask, 127, 255, cv::THRESH_BINARY);
+  if (want_depth) {
+    cv::remap(t.raw_depth, out->depth, t.map_x, t.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  } else {
+    out->depth.release();
+  }
+}
+
+Visibility Renderer::PointVisibility(int index,
+                                     const Eigen::Vector3d& p_in_world,
+                                     double tolerance_m,
+                                     bool require_person) const {
+  const Camera& cam = cameras_.at(index);
+  const Target& t = *targets_.at(index);
+  const Eigen::Vector3d p_in_cam = cam.cam_from_world * p_in_world;
+  if (p_in_cam.z() <= options_.near_m) return kOutside;
+  const Eigen::Vector2d px = cam.Project(p_in_world);
+  if (px.x() < 0 || px.y() < 0 || px.x() > cam.width - 1 || px.y() > cam.height - 1) return kOutside;
+  const Camera& rc = t.render_camera;
+  const double qx = rc.fx * p_in_cam.x() / p_in_cam.z() + rc.cx;
+  const double qy = rc.fy * p_in_cam.y() / p_in_cam.z() + rc.cy;
+  const int ix = static_cast<int>(std::lround(qx)), iy = static_cast<int>(std::lround(qy));
+  // Seen if any pinhole pixel within one output pixel shows a surface close
+  // enough in front of the point (and it is the person, when required).
+  const int r = options_.supersample;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const int x = ix + dx, y = iy + dy;
+      if (x < 0 || y < 0 || x >= rc.width || y >= rc.height) continue;
+      if (require_person && t.raw_mask.at<uint8_t>(y, x) < 128) continue;
+      const float seen_depth = t.raw_depth.at<float>(y, x);
+      if (seen_depth <= 0) continue;
+      if (seen_depth >= p_in_cam.z() - tolerance_m) return kVisible;
+    }
+  }
+  return kOccluded;
+}
+
+}  // namespace irbench

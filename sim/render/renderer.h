@@ -1,0 +1,88 @@
+#pragma once
+// The off-screen renderer: every camera into its own framebuffer, in one pass
+// with three targets (grey shading, person mask, camera depth), at a
+// supersampled pinhole resolution wide enough to cover the distorted image,
+// then resampled through the camera's exact Brown–Conrady distortion on the
+// CPU. The person mesh is uploaded once per frame and drawn by every camera.
+
+#include <Eigen/Core>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sim/camera/camera.h"
+#include "sim/gl/gl_context.h"
+#include "sim/scene/mesh.h"
+#include "sim/scene/scene.h"
+
+namespace irbench {
+
+struct RenderOptions {
+  int supersample = 2;   // pinhole pixels per output pixel, per axis
+  double near_m = 0.05;  // clip planes
+  double far_m = 80.0;
+
+  // Throws InputError for bad values.
+  void Check() const;
+};
+
+struct CameraImages {
+  cv::Mat grey;   // CV_8UC1, plain grey shading
+  cv::Mat mask;   // CV_8UC1, 255 where the person is seen, 0 else
+  cv::Mat depth;  // CV_32FC1, camera z in metres (0: nothing); empty unless asked
+};
+
+// Joint visibility codes of the data contract.
+enum Visibility : int { kOutside = 0, kOccluded = 1, kVisible = 2 };
+
+class Renderer {
+ public:
+  Renderer(GlContext& context, std::vector<Camera> cameras, const RenderOptions& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Static geometry and lighting (uploaded once).
+  void SetScene(const Scene& scene);
+  void SetStaticMesh(const TriangleMesh& mesh);
+  void SetLighting(const std::vector<IrLight>& lights, double ambient);
+
+  // Person mesh: topology once, vertices once per frame.
+  void SetPersonTopology(const std::vector<uint32_t>& indices, size_t vertex_count);
+  void UpdatePerson(const std::vector<MeshVertex>& vertices);
+  void SetPersonVisible(bool visible) { person_visible_ = visible; }
+
+  // Renders camera `index`; `out->depth` is filled only when `want_depth`.
+  void Render(int index, CameraImages* out, bool want_depth);
+
+  // Visibility of a world point in camera `index`, from that camera's last
+  // render: kOutside when it projects outside the image (or behind the camera);
+  // kVisible when the surface seen at its pixel lies no more than
+  // `tolerance_m` in front of it (and, with `require_person`, is the person);
+  // kOccluded otherwise.
+  Visibility PointVisibility(int index,
+                             const Eigen::Vector3d& p_in_world,
+                             double tolerance_m,
+                             bool require_person) const;
+
+  const std::vector<Camera>& cameras() const { return cameras_; }
+  // The pinhole camera actually rasterised for camera `index` (for tests).
+  const Camera& RenderCamera(int index) const;
+
+ private:
+  struct Target;
+  GlContext& context_;
+  const GlFunctions& gl_;
+  std::vector<Camera> cameras_;
+  RenderOptions options_;
+  std::vector<std::unique_ptr<Target>> targets_;
+  unsigned program_ = 0;
+  unsigned static_vao_ = 0, static_vbo_ = 0, static_ibo_ = 0;
+  int static_index_count_ = 0;
+  unsigned person_vao_ = 0, person_vbo_ = 0, person_ibo_ = 0;
+  int person_index_count_ = 0;
+  size_t person_vertex_count_ = 0;
+  bool person_visible_ = true;
+};
+
+}  // namespace irbench

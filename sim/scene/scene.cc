@@ -1,0 +1,169 @@
+#include "sim/scene/scene.h"
+
+#include <cmath>
+#include <set>
+
+#include "common/json_reader.h"
+
+namespace irbench {
+namespace {
+
+Material ReadMaterial(const JsonNode& node, const std::string& key, float fallback) {
+  Material m;
+  m.albedo = static_cast<float>(node.GetDouble(key, fallback));
+  if (m.albedo < 0 || m.albedo > 1) node[key].Fail("reflectance must be in [0, 1]");
+  return m;
+}
+
+void CheckBox(const JsonNode& node, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
+  if ((max - min).minCoeff() <= 0) node["max"].Fail("must exceed 'min' on every axis");
+}
+
+ScreenSurface ReadScreen(const JsonNode& s) {
+  ScreenSurface screen;
+  screen.name = s.GetString("name");
+  const std::string type = s.GetString("type");
+  if (type == "cylinder") {
+    s.CheckKeys({"name", "type", "center_xy", "radius", "angle_left_deg", "angle_right_deg", "z",
+                 "albedo", "targets", "description"});
+    screen.kind = ScreenSurface::Kind::kCylinder;
+    screen.center_xy = s["center_xy"].Vec2();
+    screen.radius = s.GetDouble("radius");
+    if (screen.radius <= 0) s["radius"].Fail("must be positive");
+    screen.angle_left_deg = s.GetDouble("angle_left_deg");
+    screen.angle_right_deg = s.GetDouble("angle_right_deg");
+    if (screen.angle_left_deg <= screen.angle_right_deg ||
+        screen.angle_left_deg - screen.angle_right_deg > 360) {
+      s["angle_left_deg"].Fail("must exceed angle_right_deg by at most 360");
+    }
+    const Eigen::Vector2d z = s["z"].Vec2();
+    screen.z0 = z.x();
+    screen.z1 = z.y();
+    if (screen.z1 <= screen.z0) s["z"].Fail("top must be above bottom");
+  } else if (type == "plane") {
+    s.CheckKeys({"name", "type", "origin", "right", "up", "width", "height", "albedo", "targets",
+                 "description"});
+    screen.kind = ScreenSurface::Kind::kPlane;
+    screen.origin = s.GetVec3("origin");
+    screen.right = s.GetVec3("right");
+    screen.up = s.GetVec3("up");
+    if (screen.right.norm() < 1e-9) s["right"].Fail("must be non-zero");
+    if (screen.up.norm() < 1e-9) s["up"].Fail("must be non-zero");
+    screen.right.normalize();
+    screen.up.normalize();
+    if (std::abs(screen.right.dot(screen.up)) > 1e-6) s["up"].Fail("must be perpendicular to 'right'");
+    screen.width = s.GetDouble("width");
+    screen.height = s.GetDouble("height");
+    if (screen.width <= 0) s["width"].Fail("must be positive");
+    if (screen.height <= 0) s["height"].Fail("must be positive");
+  } else {
+    s["type"].Fail("unknown screen type '" + type + "' (cylinder, plane)");
+  }
+  screen.material = ReadMaterial(s, "albedo", 0.8f);
+  if (s.Has("targets")) {
+    const JsonNode targets = s["targets"];
+    const Eigen::Vector2d size = screen.Size();
+    for (const std::string& name : targets.Keys()) {
+      const Eigen::Vector2d st = targets[name].Vec2();
+      if (st.x() < 0 || st.x() > size.x() || st.y() < 0 || st.y() > size.y()) {
+        targets[name].Fail("target outside the screen (size " + std::to_string(size.x()) + " x " +
+                           std::to_string(size.y()) + " m)");
+      }
+      screen.targets[name] = st;
+    }
+  }
+  return screen;
+}
+
+}  // namespace
+
+nlohmann::json Scene::ScreensJson() const {
+  nlohmann::json j;
+  j["format"] = "irbench.screens/1";
+  j["scene"] = name;
+  j["screens"] = nlohmann::json::array();
+  for (const ScreenSurface& s : screens) j["screens"].push_back(s.ToJson());
+  return j;
+}
+
+Scene LoadScene(const std::filesystem::path& path) {
+  const JsonNode root = ParseJsonFile(path.string());
+  root.CheckKeys({"format", "name", "description", "stage", "ambient", "objects", "screens", "lights"});
+  if (root.GetString("format") != "irbench.scene/1") root["format"].Fail("expected \"irbench.scene/1\"");
+  Scene scene;
+  scene.source = path;
+  scene.name = root.GetString("name", path.stem().string());
+  if (root.Has("stage")) {
+    const JsonNode stage = root["stage"];
+    stage.CheckKeys({"center", "size"});
+    scene.stage_center = stage["center"].Vec2();
+    scene.stage_size = stage["size"].Vec2();
+    if (scene.stage_size.minCoeff() <= 0) stage["size"].Fail("must be positive");
+  }
+  scene.ambient = root.GetDouble("ambient", 0.3);
+  if (scene.ambient < 0) root["ambient"].Fail("must be non-negative");
+
+  if (root.Has("objects")) {
+    const JsonNode objects = root["objects"];
+    for (size_t i = 0; i < objects.Size(); ++i) {
+      const JsonNode o = objects[i];
+      const std::string type = o.GetString("type");
+      if (type == "room") {
+        o.CheckKeys({"type", "name", "min", "max", "floor", "ceiling", "walls"});
+        const Eigen::Vector3d min = o.GetVec3("min"), max = o.GetVec3("max");
+        CheckBox(o, min, max);
+        AppendRoom(scene.mesh, min, max, ReadMaterial(o, "floor", 0.3f),
+                   ReadMaterial(o, "ceiling", 0.2f), ReadMaterial(o, "walls", 0.25f));
+      } else if (type == "box") {
+        o.CheckKeys({"type", "name", "min", "max", "albedo"});
+        const Eigen::Vector3d min = o.GetVec3("min"), max = o.GetVec3("max");
+        CheckBox(o, min, max);
+        AppendBox(scene.mesh, min, max, ReadMaterial(o, "albedo", 0.5f), false);
+      } else if (type == "quad") {
+        o.CheckKeys({"type", "name", "origin", "u", "v", "albedo"});
+        const Eigen::Vector3d u = o.GetVec3("u"), v = o.GetVec3("v");
+        if (u.cross(v).norm() < 1e-9) o["v"].Fail("must not be parallel to 'u'");
+        AppendQuad(scene.mesh, o.GetVec3("origin"), u, v, ReadMaterial(o, "albedo", 0.5f));
+      } else {
+        o["type"].Fail("unknown object type '" + type + "' (room, box, quad)");
+      }
+    }
+  }
+  if (root.Has("screens")) {
+    const JsonNode screens = root["screens"];
+    std::set<std::string> names;
+    for (size_t i = 0; i < screens.Size(); ++i) {
+      ScreenSurface screen = ReadScreen(screens[i]);
+      if (!names.insert(screen.name).second) screens[i]["name"].Fail("duplicate screen name");
+      screen.AppendGeometry(scene.mesh);
+      scene.screens.push_back(std::move(screen));
+    }
+  }
+  if (root.Has("lights")) {
+    const JsonNode lights = root["lights"];
+    if (lights.Size() > 8) lights.Fail("at most 8 lights");
+    for (size_t i = 0; i < lights.Size(); ++i) {
+      const JsonNode l = lights[i];
+      l.CheckKeys({"name", "position", "look_at", "cone_deg", "power", "wavelength_nm"});
+      IrLight light;
+      light.name = l.GetString("name");
+      light.position = l.GetVec3("position");
+      const Eigen::Vector3d dir = l.GetVec3("look_at") - light.position;
+      if (dir.norm() < 1e-9) l["look_at"].Fail("must differ from 'position'");
+      light.direction = dir.normalized();
+      light.cone_deg = l.GetDouble("cone_deg", 60.0);
+      if (light.cone_deg <= 0 || light.cone_deg > 180) l["cone_deg"].Fail("must be in (0, 180]");
+      light.power = l.GetDouble("power", 1.0);
+      if (light.power < 0) l["power"].Fail("must be non-negative");
+      light.wavelength_nm = l.GetDouble("wavelength_nm", 850.0);
+      if (light.wavelength_nm != 850.0 && light.wavelength_nm != 940.0) {
+        l["wavelength_nm"].Fail("must be 850 or 940");
+      }
+      scene.lights.push_back(light);
+    }
+  }
+  if (scene.mesh.vertices.empty()) root.Fail("scene has no geometry");
+  return scene;
+}
+
+}  // namespace irbench

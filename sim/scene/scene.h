@@ -1,0 +1,41 @@
+#pragma once
+// Scenes (scenes/*.json): static geometry, projection screens with their screen
+// frames and targets, near-IR illuminators, and the stage area where people act.
+// Format in docs/formats.md.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sim/scene/mesh.h"
+#include "sim/scene/screen.h"
+
+namespace irbench {
+
+struct IrLight {
+  std::string name;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = -Eigen::Vector3d::UnitZ();  // unit
+  double cone_deg = 60.0;  // full opening angle
+  double power = 1.0;      // relative radiant intensity on axis
+  double wavelength_nm = 850.0;
+};
+
+struct Scene {
+  std::string name;
+  std::filesystem::path source;
+  Eigen::Vector2d stage_center = Eigen::Vector2d::Zero();
+  Eigen::Vector2d stage_size = Eigen::Vector2d(3, 3);
+  double ambient = 0.3;  // diffuse light reflected from the screens, relative
+  std::vector<ScreenSurface> screens;
+  std::vector<IrLight> lights;
+  TriangleMesh mesh;  // all static geometry, screens included
+
+  // calib/screens.json content.
+  nlohmann::json ScreensJson() const;
+};
+
+Scene LoadScene(const std::filesystem::path& path);
+
+}  // namespace irbench

@@ -1,0 +1,51 @@
+#include "sim/sequence/image_io.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+
+namespace irbench {
+
+std::string EncodePng(const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw RuntimeError("PNG encoding failed");
+  }
+  return std::string(bytes.begin(), bytes.end());
+}
+
+void WritePngAtomic(const std::filesystem::path& path, const cv::Mat& image) {
+  AtomicWriteFile(path, EncodePng(image));
+}
+
+void WriteDepthExrAtomic(const std::filesystem::path& path, const cv::Mat& depth) {
+  CV_Assert(depth.type() == CV_32FC1 && depth.isContinuous());
+  const std::filesystem::path tmp =
+      path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
+  try {
+    Imf::Header header(depth.cols, depth.rows);
+    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    header.compression() = Imf::ZIP_COMPRESSION;
+    Imf::OutputFile file(tmp.c_str(), header);
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(depth.data),
+                                        sizeof(float), sizeof(float) * depth.cols));
+    file.setFrameBuffer(frame_buffer);
+    file.writePixels(depth.rows);
+  } catch (const std::exception& e) {
+    std::filesystem::remove(tmp);
+    throw RuntimeError("cannot write " + path.string() + ": " + e.what());
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw RuntimeError("cannot rename into " + path.string() + ": " + ec.message());
+}
+
+}  // namespace irbench

@@ -1,0 +1,271 @@
+#include "sim/sequence/render_job.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+#include "common/atomic_file.h"
+#include "common/cancel.h"
+#include "common/error.h"
+#include "common/logging.h"
+#include "common/paths.h"
+#include "sim/sequence/calib_io.h"
+#include "sim/sequence/image_io.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string FrameName(int frame, const char* ext) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%06d.%s", frame, ext);
+  return buffer;
+}
+
+double TruthTolerance(const Avatar& avatar, const std::string& joint_name) {
+  // "left_elbow" -> "elbow"; a point is seen when the surface at its pixel lies
+  // within its body radius (plus 3 cm of slack for the skin's curvature).
+  std::string key = joint_name;
+  for (const char* prefix : {"left_", "right_"}) {
+    if (key.rfind(prefix, 0) == 0) key = key.substr(std::string(prefix).size());
+  }
+  const auto it = avatar.truth_radius.find(key);
+  const double radius = it != avatar.truth_radius.end() ? it->second : 0.05;
+  return key == "root" ? 0.05 : radius + 0.03;
+}
+
+nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
+  RenderInputs in;
+  if (options.sensor != "clean") {
+    throw InputError("", "--sensor",
+                     "unknown preset '" + options.sensor +
+                         "' (available: clean; 'thesis' and 'harsh' arrive with the sensor model)");
+  }
+  if (options.frames && (*options.frames < 1 || *options.frames > 1000000)) {
+    throw InputError("", "--frames", "must be in 1..1000000");
+  }
+  if (options.background_frames < 0 || options.background_frames > 10000) {
+    throw InputError("", "--background-frames", "must be in 0..10000");
+  }
+  if (options.supersample < 1 || options.supersample > 4) {
+    throw InputError("", "--supersample", "must be in 1..4");
+  }
+  in.rig_file = ResolveDataFile("rigs", options.rig, "--rig");
+  in.rig = LoadRig(in.rig_file);
+  const std::string scene_name = options.scene.empty() ? in.rig.scene : options.scene;
+  if (scene_name.empty()) throw InputError("", "--scene", "not given and the rig names no scene");
+  in.scene_file = ResolveDataFile("scenes", scene_name, "--scene");
+  in.scene = LoadScene(in.scene_file);
+  in.avatar_file = ResolveDataFile("avatars", options.avatar, "--avatar");
+  in.avatar = LoadAvatar(in.avatar_file);
+  in.motion_file = ResolveDataFile("motions", options.motion, "--motion");
+  in.motion = LoadKeyframes(in.motion_file);
+  in.motion_name = in.motion->name();
+  in.fps = in.rig.cameras.front().fps;
+  for (size_t i = 1; i < in.rig.cameras.size(); ++i) {
+    if (in.rig.cameras[i].fps != in.fps) {
+      throw InputError(in.rig_file.string(), "cameras[" + std::to_string(i) + "].fps",
+                       "differs from cameras[0].fps; per-camera clocks are not supported yet");
+    }
+  }
+  in.frame_count = options.frames.value_or(
+      static_cast<int>(std::floor(in.motion->duration() * in.fps + 1e-9)) + 1);
+  return in;
+}
+
+JointTransforms PoseAndUpload(const RenderInputs& inputs,
+                              double t,
+                              Renderer& renderer,
+                              std::vector<MeshVertex>& skinned) {
+  const Pose pose = inputs.motion->At(t);
+  const JointTransforms world_from_joint = ForwardKinematics(inputs.avatar.skeleton, pose);
+  SkinVertices(inputs.avatar, world_from_joint, skinned);
+  renderer.UpdatePerson(skinned);
+  return world_from_joint;
+}
+
+FrameTruth ComputeFrameTruth(const RenderInputs& inputs,
+                             const JointTransforms& world_from_joint,
+                             const Renderer& renderer) {
+  FrameTruth truth;
+  truth.joints3d = TruthJoints(inputs.avatar, world_from_joint);
+  const auto& names = TruthJointNames();
+  for (size_t c = 0; c < renderer.cameras().size(); ++c) {
+    const Camera& cam = renderer.cameras()[c];
+    std::vector<Eigen::Vector3d> per_joint;
+    for (size_t j = 0; j < names.size(); ++j) {
+      const Eigen::Vector2d px = cam.Project(truth.joints3d[j]);
+      const bool is_root = names[j] == "root";
+      const Visibility vis = renderer.PointVisibility(
+          static_cast<int>(c), truth.joints3d[j], TruthTolerance(inputs.avatar, names[j]), !is_root);
+      per_joint.emplace_back(px.x(), px.y(), static_cast<double>(vis));
+    }
+    truth.joints2d.push_back(per_joint);
+  }
+  return truth;
+}
+
+fs::path RunRenderJob(const RenderJobOptions& options) {
+  // 1. Everything from outside is checked before anything is created.
+  const RenderInputs in = LoadRenderInputs(options);
+  fs::path out = options.out;
+  if (out.empty()) {
+    out = DataRoot() / "renders" /
+          (in.rig.name + "-" + in.avatar.params.name + "-" + in.motion_name + "-s" +
+           std::to_string(options.seed));
+  }
+  // Checks the parent folder and an existing output before the slow GL start.
+  if (!fs::is_directory(fs::absolute(out).parent_path())) {
+    throw InputError("", "--out", "parent folder '" + fs::absolute(out).parent_path().string() +
+                                      "' does not exist");
+  }
+  if (fs::exists(out) && !options.overwrite) {
+    throw InputError("", "--out", "'" + out.string() + "' exists (pass --force to replace it)");
+  }
+
+  // 2. GL and the renderer.
+  auto context = CreateGlContext(options.backend);
+  Log().info("render: {} backend, {}", context->BackendName(), context->RendererString());
+  RenderOptions render_options;
+  render_options.supersample = options.supersample;
+  Renderer renderer(*context, in.rig.cameras, render_options);
+  renderer.SetScene(in.scene);
+  renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
+
+  // 3. The staging folder and the static files.
+  StagingDir staging(out, options.overwrite, "--out");
+  const fs::path root = staging.path();
+  for (const char* dir : {"calib", "background", "frames", "truth", "truth/masks"}) {
+    fs::create_directories(root / dir);
+  }
+  for (const Camera& cam : in.rig.cameras) {
+    fs::create_directories(root / "background" / cam.name);
+    fs::create_directories(root / "frames" / cam.name);
+    fs::create_directories(root / "truth" / "masks" / cam.name);
+    if (options.write_depth) fs::create_directories(root / "truth" / "depth" / cam.name);
+  }
+  AtomicWriteFile(root / "calib" / "intri.yml", IntriYaml(in.rig.cameras));
+  AtomicWriteFile(root / "calib" / "extri.yml", ExtriYaml(in.rig.cameras));
+  AtomicWriteFile(root / "calib" / "cameras.json",
+                  CamerasJson(in.rig.cameras, options.sensor).dump(2) + "\n");
+  AtomicWriteFile(root / "calib" / "screens.json", in.scene.ScreensJson().dump(2) + "\n");
+
+  nlohmann::json manifest;
+  manifest["format"] = "irbench.sequence/1";
+  manifest["tool_version"] = ToolVersion();
+  manifest["seed"] = options.seed;
+  manifest["scene"] = {{"name", in.scene.name}, {"file", in.scene_file.filename().string()}};
+  manifest["rig"] = {{"name", in.rig.name}, {"file", in.rig_file.filename().string()}};
+  manifest["avatar"] = {{"name", in.avatar.params.name},
+                        {"file", in.avatar_file.filename().string()},
+                        {"kind", "tube"},
+                        {"build", in.avatar.params.build}};
+  manifest["motion"] = {{"name", in.motion_name},
+                        {"file", in.motion_file.filename().string()},
+                        {"kind", "keyframes"}};
+  manifest["sensor"] = options.sensor;
+  manifest["fps"] = in.fps;
+  manifest["frame_count"] = in.frame_count;
+  manifest["background_frame_count"] = options.background_frames;
+  nlohmann::json camera_names = nlohmann::json::array();
+  for (const Camera& cam : in.rig.cameras) camera_names.push_back(cam.name);
+  manifest["cameras"] = camera_names;
+  manifest["body_height_m"] = in.avatar.params.height_m;
+  manifest["joints"] = TruthJointNames();
+  manifest["depth"] = options.write_depth;
+  manifest["renderer"] = {{"backend", context->BackendName()},
+                          {"gl", context->RendererString()},
+                          {"supersample", options.supersample}};
+  manifest["files"] = {{"frames", "frames/<cam>/NNNNNN.png"},
+                       {"background", "background/<cam>/NNNNNN.png"},
+                       {"masks", "truth/masks/<cam>/NNNNNN.png"},
+                       {"truth", "truth/frames.jsonl"}};
+  if (options.write_depth) manifest["files"]["depth"] = "truth/depth/<cam>/NNNNNN.exr";
+
+  const auto start = std::chrono::steady_clock::now();
+  auto last_report = start;
+  const int total = options.background_frames + in.frame_count;
+  int done = 0;
+  auto report = [&](const char* phase, int index, int count) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_report < std::chrono::seconds(1) && index + 1 < count) return;
+    last_report = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    Log().info("render: {} {}/{} ({:.1f} frame-sets/s)", phase, index + 1, count,
+               elapsed > 0 ? done / elapsed : 0.0);
+  };
+
+  // 4. Empty-stage frames.
+  CameraImages images;
+  renderer.SetPersonVisible(false);
+  for (int f = 0; f < options.background_frames; ++f) {
+    ThrowIfCancelled();
+    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+      renderer.Render(static_cast<int>(c), &images, false);
+      WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), images.grey);
+    }
+    ++done;
+    report("background", f, options.background_frames);
+  }
+
+  // 5. The sequence.
+  renderer.SetPersonVisible(true);
+  std::vector<MeshVertex> skinned;
+  std::string truth_lines;
+  const auto& joint_names = TruthJointNames();
+  for (int f = 0; f < in.frame_count; ++f) {
+    ThrowIfCancelled();
+    const double t = f / in.fps;
+    const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);
+    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+      const std::string& cam_name = in.rig.cameras[c].name;
+      renderer.Render(static_cast<int>(c), &images, options.write_depth);
+      WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), images.grey);
+      WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), images.mask);
+      if (options.write_depth) {
+        WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"), images.depth);
+      }
+    }
+    const FrameTruth truth = ComputeFrameTruth(in, world_from_joint, renderer);
+    nlohmann::json line;
+    line["frame"] = f;
+    line["t"] = t;
+    const Eigen::Vector3d& root_point = truth.joints3d[0];
+    const Eigen::Vector2d stage_offset = root_point.head<2>() - in.scene.stage_center;
+    line["present"] = std::abs(stage_offset.x()) <= in.scene.stage_size.x() / 2 &&
+                      std::abs(stage_offset.y()) <= in.scene.stage_size.y() / 2;
+    nlohmann::json joints3d = nlohmann::json::object();
+    for (size_t j = 0; j < joint_names.size(); ++j) joints3d[joint_names[j]] = Vec(truth.joints3d[j]);
+    line["joints3d"] = joints3d;
+    nlohmann::json joints2d = nlohmann::json::object();
+    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+      nlohmann::json per_cam = nlohmann::json::object();
+      for (size_t j = 0; j < joint_names.size(); ++j) {
+        const Eigen::Vector3d& uvv = truth.joints2d[c][j];
+        per_cam[joint_names[j]] = {uvv.x(), uvv.y(), static_cast<int>(uvv.z())};
+      }
+      joints2d[in.rig.cameras[c].name] = per_cam;
+    }
+    line["joints2d"] = joints2d;
+    line["labels"] = {{"gesture", nullptr}, {"posture", nullptr}, {"rest", nullptr}, {"motion", nullptr}};
+    line["pointing"] = {{"left", nullptr}, {"right", nullptr}};
+    truth_lines += line.dump() + "\n";
+    ++done;
+    report("frame", f, in.frame_count);
+  }
+  AtomicWriteFile(root / "truth" / "frames.jsonl", truth_lines);
+  AtomicWriteFile(root / "manifest.json", manifest.dump(2) + "\n");
+  ThrowIfCancelled();
+  staging.Commit();
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  Log().info("render: {} frame-sets ({} cameras) in {:.1f} s", total, in.rig.cameras.size(), elapsed);
+  return staging.final_path();
+}
+
+}  // namespace irbench

@@ -1,0 +1,72 @@
+#pragma once
+// `irbench render`: load a scene, rig, avatar and motion; render every camera
+// for every frame; write a sequence folder (docs/sequence-format.md) under a
+// staging name and rename it into place when complete.
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "sim/body/avatar.h"
+#include "sim/body/keyframes.h"
+#include "sim/camera/rig.h"
+#include "sim/gl/gl_context.h"
+#include "sim/render/renderer.h"
+#include "sim/scene/scene.h"
+
+namespace irbench {
+
+struct RenderJobOptions {
+  std::string scene;  // name or path; empty: the rig's scene
+  std::string rig = "theater4";
+  std::string avatar = "p1";
+  std::string motion = "wave";
+  std::optional<int> frames;  // default: the motion's duration
+  int background_frames = 10;
+  uint64_t seed = 1;
+  std::string sensor = "clean";
+  std::filesystem::path out;  // empty: renders/<rig>-<avatar>-<motion>-s<seed>
+  bool overwrite = false;
+  bool write_depth = false;
+  GlBackend backend = GlBackend::kAuto;
+  int supersample = 2;
+};
+
+// Everything a render needs, loaded and validated (InputError on bad input).
+struct RenderInputs {
+  Scene scene;
+  Rig rig;
+  Avatar avatar;
+  std::optional<KeyframeMotion> motion;
+  std::string motion_name;
+  std::filesystem::path scene_file, rig_file, avatar_file, motion_file;
+  int frame_count = 0;
+  double fps = 30;
+};
+
+RenderInputs LoadRenderInputs(const RenderJobOptions& options);
+
+// Per-frame truth joints and their projections, for one posed frame.
+struct FrameTruth {
+  std::vector<Eigen::Vector3d> joints3d;  // TruthJointNames() order
+  // [camera][joint] = (u, v, visibility)
+  std::vector<std::vector<Eigen::Vector3d>> joints2d;
+};
+
+// Poses the avatar at time t, skins it (once) and uploads it to the renderer.
+JointTransforms PoseAndUpload(const RenderInputs& inputs,
+                              double t,
+                              Renderer& renderer,
+                              std::vector<MeshVertex>& skinned);
+
+// Projects the truth joints into every camera with visibility from the
+// renderer's last images of each camera.
+FrameTruth ComputeFrameTruth(const RenderInputs& inputs,
+                             const JointTransforms& world_from_joint,
+                             const Renderer& renderer);
+
+// Runs the whole job; returns the final sequence folder. Polls for SIGINT.
+std::filesystem::path RunRenderJob(const RenderJobOptions& options);
+
+}  // namespace irbench
