@@ -121,7 +121,7 @@ struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
   cv::Mat map_x, map_y;  // output pixel -> render pixel
-  cv::Mat raw_grey, raw_mask, raw_depth;
+  cv::Mat raw_grey, raw_mask, raw_depth, blurred_grey;
   Eigen::Matrix4f clip_from_world;
 };
 
@@ -358,7 +358,11 @@ void Renderer::Render(int index, CameraImages* out, bool want_depth) {
 
   // Resample through the distortion. Grey: bilinear over the supersampled
   // image (a box filter when undistorted); mask: coverage >= 50%; depth: nearest.
-  cv::remap(t.raw_grey, out->grey, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  // The grey image is low-passed first (a Gaussian of 0.5 output pixels, about a
+  // good lens's blur) so edges fall between supersamples instead of snapping
+  // to them; this keeps sub-pixel corner positions unbiased and steady.
+  cv::GaussianBlur(t.raw_grey, t.blurred_grey, cv::Size(0, 0), 0.5 * options_.supersample);
+  cv::remap(t.blurred_grey, out->grey, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   cv::Mat coverage;
   cv::remap(t.raw_mask, coverage, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   cv::threshold(coverage, out->mask, 127, 255, cv::THRESH_BINARY);

@@ -1,0 +1,153 @@
+#include "sim/render/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sim/camera/rig.h"
+
+namespace irbench {
+namespace {
+
+Camera TheaterCamera(int index) {
+  return LoadRig(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json").cameras.at(index);
+}
+
+class RendererTest : public ::testing::TestWithParam<GlBackend> {};
+
+// The mask of a sphere matches its analytic projection through the distorted
+// camera (a pixel is inside when its ray meets the sphere).
+TEST_P(RendererTest, SphereMaskMatchesAnalyticProjection) {
+  auto context = CreateGlContext(GetParam());
+  for (int cam_index : {0, 2}) {  // a mild and a wide, strongly distorted lens
+    const Camera cam = TheaterCamera(cam_index);
+    Renderer renderer(*context, {cam}, RenderOptions{});
+    // Off-centre, so the distortion matters.
+    const Eigen::Vector3d center_in_cam(0.9, -0.5, 2.6);
+    const Eigen::Vector3d center = cam.cam_from_world.inverse() * center_in_cam;
+    const double radius = 0.35;
+    TriangleMesh sphere;
+    AppendSphere(sphere, center, radius, Material{0.6f, 0.0f}, 128, 64);
+    renderer.SetPersonTopology(sphere.indices, sphere.vertices.size());
+    renderer.UpdatePerson(sphere.vertices);
+    CameraImages images;
+    renderer.Render(0, &images, true);
+
+    const Eigen::Vector3d eye = cam.CenterInWorld();
+    int inter = 0, uni = 0, analytic_area = 0;
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        const Eigen::Vector3d dir = *cam.PixelRayInWorld({double(u), double(v)});
+        const double along = (center - eye).dot(dir);
+        const bool inside = along > 0 && ((center - eye) - along * dir).norm() < radius;
+        const bool rendered = images.mask.at<uint8_t>(v, u) == 255;
+        inter += inside && rendered;
+        uni += inside || rendered;
+        analytic_area += inside;
+      }
+    }
+    ASSERT_GT(analytic_area, 1000) << "sphere too small to test";
+    const double iou = double(inter) / uni;
+    EXPECT_GE(iou, 0.98) << cam.name;
+    RecordProperty("sphere_iou_" + cam.name, std::to_string(iou));
+    // Depth at the sphere's projected centre is its front surface.
+    const Eigen::Vector2d px = cam.Project(center);
+    const float depth = images.depth.at<float>(int(std::lround(px.y())), int(std::lround(px.x())));
+    // Camera depth is z in the camera frame, along the ray through the centre.
+    const double along_ray = (center - eye).norm() - radius;
+    EXPECT_NEAR(depth, along_ray * center_in_cam.z() / center_in_cam.norm(), 0.01);
+  }
+}
+
+// A checkerboard rendered at 24 poses is found by OpenCV, and calibrateCamera
+// recovers the rig's intrinsics: the pixels and the written calibration agree.
+TEST_P(RendererTest, CheckerboardCalibrationRecoversTheRig) {
+  auto context = CreateGlContext(GetParam());
+  const Camera cam = TheaterCamera(0);
+  RenderOptions options;
+  options.supersample = 2;
+  Renderer renderer(*context, {cam}, options);
+  const int cols = 7, rows = 5;
+  const double square = 0.065;
+  std::vector<std::vector<cv::Point3f>> object_points;
+  std::vector<std::vector<cv::Point2f>> image_points;
+  std::vector<cv::Point3f> board;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) board.emplace_back(float(c * square), float(r * square), 0.f);
+  const Eigen::Isometry3d world_from_cam = cam.cam_from_world.inverse();
+  int found = 0, n_corners = 0;
+  double sum_dx = 0, sum_dy = 0, sum_sq = 0;
+  for (int i = 0; i < 48; ++i) {
+    // A 3 x 2 grid of positions over the image at two depths, each seen
+    // tilted about a different axis (up to ~37 degrees), as a careful
+    // calibration session would.
+    const double x = -0.2 + 0.2 * (i % 3), y = (i / 3) % 2 == 0 ? -0.12 : 0.12;
+    const double z = 0.95 + 0.175 * ((i / 6) % 3);
+    const double tilt = (i < 36 ? 0.65 : 0.35) * (((i / 18) % 2) == 0 ? 1 : -1);
+    const double tilt_x = (i % 2 == 0) ? tilt : 0.25 * tilt, tilt_y = (i % 2 == 0) ? 0.25 * tilt : tilt;
+    Eigen::Isometry3d cam_from_board = Eigen::Isometry3d::Identity();
+    cam_from_board.linear() = (Eigen::AngleAxisd(tilt_x, Eigen::Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(tilt_y, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(0.15 * std::sin(i), Eigen::Vector3d::UnitZ()))
+                                  .toRotationMatrix();
+    const Eigen::Vector3d board_center((cols - 1) * square / 2, (rows - 1) * square / 2, 0);
+    cam_from_board.translation() = Eigen::Vector3d(x, y, z) - cam_from_board.linear() * board_center;
+    TriangleMesh mesh;
+    AppendCheckerboard(mesh, world_from_cam * cam_from_board, cols, rows, square);
+    renderer.SetStaticMesh(mesh);
+    CameraImages images;
+    renderer.Render(0, &images, false);
+    std::vector<cv::Point2f> corners;
+    if (!cv::findChessboardCorners(images.grey, {cols, rows}, corners,
+                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+      continue;
+    }
+    cv::cornerSubPix(images.grey, corners, {6, 6}, {-1, -1},
+                     {cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 100, 1e-4});
+    // Detected corners against the exact projection of the board's corners.
+    for (size_t c = 0; c < corners.size(); ++c) {
+      const Eigen::Vector3d corner_in_world =
+          world_from_cam * cam_from_board *
+          Eigen::Vector3d(board[c].x, board[c].y, board[c].z);
+      const Eigen::Vector2d expected = cam.Project(corner_in_world);
+      sum_dx += corners[c].x - expected.x();
+      sum_dy += corners[c].y - expected.y();
+      sum_sq += std::pow(corners[c].x - expected.x(), 2) + std::pow(corners[c].y - expected.y(), 2);
+      ++n_corners;
+    }
+    object_points.push_back(board);
+    image_points.push_back(corners);
+    ++found;
+  }
+  ASSERT_GE(found, 15);
+  std::printf("detected corners - exact projections: mean (%.3f, %.3f) px, rms %.3f px over %d\n",
+              sum_dx / n_corners, sum_dy / n_corners, std::sqrt(sum_sq / n_corners), n_corners);
+  // No bias: the rendered pixels agree with the camera model.
+  EXPECT_LT(std::hypot(sum_dx, sum_dy) / n_corners, 0.03);
+  cv::Mat k, dist;
+  std::vector<cv::Mat> rvecs, tvecs;
+  const double rms = cv::calibrateCamera(object_points, image_points, {cam.width, cam.height}, k, dist,
+                                         rvecs, tvecs, cv::CALIB_FIX_K3);
+  EXPECT_LT(rms, 0.25);
+  EXPECT_NEAR(k.at<double>(0, 0), cam.fx, 0.005 * cam.fx);
+  EXPECT_NEAR(k.at<double>(1, 1), cam.fy, 0.005 * cam.fy);
+  EXPECT_NEAR(k.at<double>(0, 2), cam.cx, 0.005 * cam.cx);
+  EXPECT_NEAR(k.at<double>(1, 2), cam.cy, 0.005 * cam.cy);
+  EXPECT_NEAR(dist.at<double>(0), cam.dist[0], 0.02);
+  RecordProperty("rms_px", std::to_string(rms));
+  std::printf("calibration: %d views, rms %.3f px, fx %.2f (%.2f) fy %.2f (%.2f) cx %.2f (%.2f) "
+              "cy %.2f (%.2f) k1 %.4f (%.4f)\n",
+              found, rms, k.at<double>(0, 0), cam.fx, k.at<double>(1, 1), cam.fy, k.at<double>(0, 2),
+              cam.cx, k.at<double>(1, 2), cam.cy, dist.at<double>(0), cam.dist[0]);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RendererTest,
+                         ::testing::Values(GlBackend::kEgl, GlBackend::kOsMesa),
+                         [](const auto& info) {
+                           return info.param == GlBackend::kEgl ? std::string("egl")
+                                                                : std::string("osmesa");
+                         });
+
+}  // namespace
+}  // namespace irbench

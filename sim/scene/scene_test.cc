@@ -1,0 +1,84 @@
+#include "sim/scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace irbench {
+namespace {
+
+std::vector<Scene> AllScenes() {
+  std::vector<Scene> scenes;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(IRBENCH_SOURCE_DIR) + "/scenes")) {
+    if (e.path().extension() == ".json") scenes.push_back(LoadScene(e.path()));
+  }
+  return scenes;
+}
+
+TEST(SceneTest, ShippedScenesLoadWithScreensAndTargets) {
+  const auto scenes = AllScenes();
+  std::set<std::string> names;
+  for (const Scene& s : scenes) {
+    names.insert(s.name);
+    EXPECT_GT(s.mesh.TriangleCount(), 10u) << s.name;
+    ASSERT_FALSE(s.screens.empty()) << s.name;
+    for (const ScreenSurface& screen : s.screens) EXPECT_FALSE(screen.targets.empty()) << s.name;
+    EXPECT_FALSE(s.lights.empty()) << s.name;
+  }
+  EXPECT_TRUE(names.count("theater") && names.count("flatworld") && names.count("lab"));
+}
+
+// A ray from the stage to each target's world point hits the screen at that
+// target's screen coordinates, and the nearest target is the target itself.
+TEST(SceneTest, RaysToTargetsHitTheirScreenCoordinates) {
+  for (const Scene& s : AllScenes()) {
+    const Eigen::Vector3d eye(s.stage_center.x(), s.stage_center.y(), 1.6);
+    for (const ScreenSurface& screen : s.screens) {
+      for (const auto& [name, st] : screen.targets) {
+        const Eigen::Vector3d p = screen.PointAt(st);
+        const auto hit = screen.Intersect(eye, (p - eye).normalized());
+        ASSERT_TRUE(hit.has_value()) << s.name << "/" << name;
+        EXPECT_NEAR(hit->x(), st.x(), 1e-9);
+        EXPECT_NEAR(hit->y(), st.y(), 1e-9);
+        EXPECT_EQ(screen.NearestTarget(*hit), name);
+      }
+    }
+  }
+}
+
+TEST(SceneTest, CylinderScreenCoordinatesAreArcLengthFromTheLeftEdge) {
+  ScreenSurface screen;
+  screen.kind = ScreenSurface::Kind::kCylinder;
+  screen.radius = 4.0;
+  screen.angle_left_deg = 150;
+  screen.angle_right_deg = 30;
+  screen.z0 = 1.0;
+  screen.z1 = 3.0;
+  EXPECT_NEAR(screen.Size().x(), 4.0 * 120 * M_PI / 180, 1e-12);
+  // The middle of the arc is straight ahead (+y) of the centre.
+  const Eigen::Vector3d mid = screen.PointAt({screen.Size().x() / 2, 0.5});
+  EXPECT_NEAR(mid.x(), 0, 1e-12);
+  EXPECT_NEAR(mid.y(), 4.0, 1e-12);
+  EXPECT_NEAR(mid.z(), 1.5, 1e-12);
+  // s grows towards the viewer's right (+x when facing +y).
+  EXPECT_LT(screen.PointAt({1.0, 0}).x(), screen.PointAt({2.0, 0}).x());
+  // Looking backwards misses.
+  EXPECT_FALSE(screen.Intersect({0, 0, 1.5}, {0, -1, 0}).has_value());
+}
+
+TEST(SceneTest, PlaneScreenIsHitOnlyFromTheFront) {
+  ScreenSurface screen;
+  screen.origin = {-1, 3, 0.5};
+  screen.right = {1, 0, 0};
+  screen.up = {0, 0, 1};
+  screen.width = 2;
+  screen.height = 1.5;
+  const auto hit = screen.Intersect({0, 0, 1}, {0, 1, 0});
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_NEAR(hit->x(), 1.0, 1e-12);
+  EXPECT_NEAR(hit->y(), 0.5, 1e-12);
+  EXPECT_FALSE(screen.Intersect({0, 5, 1}, {0, -1, 0}).has_value());
+}
+
+}  // namespace
+}  // namespace irbench

@@ -1,0 +1,174 @@
+// The irbench program as a user meets it: --help everywhere, one clear line and
+// exit code 2 for bad input with nothing left behind, SIGINT leaves no
+// half-written file.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "tests/test_util.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+using irbench::testing::FreshTempDir;
+using irbench::testing::ReadText;
+using irbench::testing::WriteText;
+
+const std::string kIrbench = std::string(IRBENCH_BINARY_DIR) + "/irbench";
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+Result RunIrbench(const std::vector<std::string>& args, const fs::path& dir) {
+  std::string command = kIrbench;
+  for (const std::string& a : args) command += " '" + a + "'";
+  command += " > '" + (dir / "stdout.txt").string() + "' 2> '" + (dir / "stderr.txt").string() + "'";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadText(dir / "stdout.txt");
+  r.err = ReadText(dir / "stderr.txt");
+  return r;
+}
+
+// Entries of `dir` other than the captured output files.
+std::vector<std::string> Leftovers(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name != "stdout.txt" && name != "stderr.txt" && name.rfind("input", 0) != 0) {
+      names.push_back(name);
+    }
+  }
+  return names;
+}
+
+TEST(CliTest, HelpOnEveryCommand) {
+  const fs::path dir = FreshTempDir("cli_help");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--help"}, {"render", "--help"}, {"bench", "--help"},
+        {"bench", "render", "--help"}}) {
+    const Result r = RunIrbench(args, dir);
+    EXPECT_EQ(r.exit_code, 0);
+    EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
+  }
+  EXPECT_EQ(RunIrbench({"render", "--no-such-option"}, dir).exit_code, 2);
+  EXPECT_EQ(RunIrbench({}, dir).exit_code, 2);
+}
+
+const char* kGoodCamera = R"({"name": "c0", "fx": 300, "fy": 300, "cx": 160, "cy": 120,
+  "dist": [0, 0, 0, 0, 0], "position": [0, 3, 1], "look_at": [0, 0, 1]})";
+
+std::string RigWith(const std::string& camera) {
+  return std::string(R"({"format": "irbench.rig/1", "scene": "theater", "cameras": [)") + camera + "]}";
+}
+
+struct BadCase {
+  std::string name;
+  std::string input_file;  // written as dir/input.json when non-empty
+  std::vector<std::string> args;
+  std::vector<std::string> message_has;  // file and field
+};
+
+TEST(CliTest, BadInputGivesOneLineExitTwoAndNothingBehind) {
+  std::string missing_fx = kGoodCamera;
+  missing_fx.replace(missing_fx.find("\"fx\": 300, "), 11, "");
+  std::string negative_fx = kGoodCamera;
+  negative_fx.replace(negative_fx.find("\"fx\": 300"), 9, "\"fx\": -300");
+  const std::string good_rig = RigWith(kGoodCamera);
+  const std::vector<BadCase> cases = {
+      {"missing_intrinsic", RigWith(missing_fx), {"--rig", "@input"}, {"input.json", "cameras[0].fx"}},
+      {"negative_focal", RigWith(negative_fx), {"--rig", "@input"}, {"input.json", "cameras[0].fx"}},
+      {"unknown_scene", "", {"--scene", "no_such_scene"}, {"--scene", "no_such_scene"}},
+      {"truncated_json", good_rig.substr(0, good_rig.size() / 2), {"--rig", "@input"},
+       {"input.json", "line"}},
+      {"missing_parent", "", {"--out", "@dir/no/such/parent/seq"}, {"--out", "does not exist"}},
+      {"bad_backend", "", {"--backend", "vulkan"}, {"--backend"}},
+      {"bad_sensor", "", {"--sensor", "foggy"}, {"--sensor"}},
+  };
+  for (const BadCase& c : cases) {
+    const fs::path dir = FreshTempDir("cli_bad_" + c.name);
+    std::vector<std::string> args = {"render", "--frames", "2"};
+    bool has_out = false;
+    for (std::string a : c.args) {
+      if (a == "@input") a = (dir / "input.json").string();
+      if (a.rfind("@dir", 0) == 0) a = dir.string() + a.substr(4);
+      has_out = has_out || a.find("/no/such/") != std::string::npos;
+      args.push_back(a);
+    }
+    if (!has_out) {
+      args.push_back("--out");
+      args.push_back((dir / "seq").string());
+    }
+    if (!c.input_file.empty()) WriteText(dir / "input.json", c.input_file);
+    const Result r = RunIrbench(args, dir);
+    EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    for (const std::string& part : c.message_has) {
+      EXPECT_NE(r.err.find(part), std::string::npos) << c.name << ": '" << part << "' not in " << r.err;
+    }
+    EXPECT_TRUE(Leftovers(dir).empty()) << c.name;
+  }
+}
+
+TEST(CliTest, RenderWritesTheSequenceAndPrintsWhere) {
+  const fs::path dir = FreshTempDir("cli_render");
+  const Result r = RunIrbench({"render", "--frames", "3", "--background-frames", "1", "--out",
+                        (dir / "seq").string()},
+                       dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, (dir / "seq").string() + "\n");
+  for (const char* file : {"manifest.json", "calib/intri.yml", "calib/extri.yml", "calib/cameras.json",
+                           "calib/screens.json", "truth/frames.jsonl",
+                           "frames/front_left/000002.png", "truth/masks/side/000000.png",
+                           "background/overhead/000000.png"}) {
+    EXPECT_TRUE(fs::exists(dir / "seq" / file)) << file;
+  }
+  EXPECT_EQ(Leftovers(dir), std::vector<std::string>{"seq"});
+  // An existing output is refused without --force, replaced with it.
+  EXPECT_EQ(RunIrbench({"render", "--frames", "1", "--out", (dir / "seq").string()}, dir).exit_code, 2);
+  EXPECT_EQ(RunIrbench({"render", "--frames", "1", "--out", (dir / "seq").string(), "--force"}, dir).exit_code, 0);
+  EXPECT_FALSE(fs::exists(dir / "seq/frames/front_left/000002.png"));
+}
+
+TEST(CliTest, InterruptLeavesNoHalfWrittenFile) {
+  const fs::path dir = FreshTempDir("cli_sigint");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string out = (dir / "seq").string();
+    const std::string log = (dir / "stderr.txt").string();
+    freopen(log.c_str(), "w", stderr);
+    execl(kIrbench.c_str(), kIrbench.c_str(), "render", "--frames", "5000", "--out", out.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until frames are being written into the staging folder.
+  bool writing = false;
+  for (int i = 0; i < 600 && !writing; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (e.path().filename().string().find(".partial-") != std::string::npos &&
+          fs::exists(e.path() / "frames/side/000003.png")) {
+        writing = true;
+      }
+    }
+  }
+  ASSERT_TRUE(writing);
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_TRUE(Leftovers(dir).empty());
+}
+
+}  // namespace
+}  // namespace irbench
