@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Installs what is missing (Debian 12), builds, and runs every test.
+# The README's second command and what CI runs (.ci/run).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./ci/install_deps.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j"$(nproc)"
+ctest --test-dir build --output-on-failure -j"$(nproc)"
