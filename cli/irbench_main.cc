@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   std::string bench_backend = "auto";
   int bench_frames = 60;
   CLI::App* bench_render = bench_cmd->add_subcommand(
-      "render", "Frame-sets per second of the render path at 320x240 and 640x480");
+      "render", "Frame-sets per second of the render path at 1x and 2x the rig's resolution\n(320x240 and 640x480 for the shipped rigs)");
   AddRenderInputOptions(bench_render, bench, bench_backend);
   bench_render->add_option("--frames", bench_frames, "timed frame-sets per resolution")
       ->capture_default_str();

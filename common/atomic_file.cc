@@ -4,26 +4,11 @@
 
 #include <cstdio>
 #include <fstream>
-#include <mutex>
-#include <set>
 
 #include "common/error.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
-
-namespace {
-
-std::mutex& StagingMutex() {
-  static std::mutex mutex;
-  return mutex;
-}
-std::set<std::string>& StagingSet() {
-  static std::set<std::string> dirs;
-  return dirs;
-}
-
-}  // namespace
 
 void AtomicWriteFile(const fs::path& path, std::string_view bytes) {
   const fs::path tmp = path.parent_path() /
@@ -64,8 +49,6 @@ StagingDir::StagingDir(const fs::path& final_path, bool overwrite, const std::st
   if (!fs::create_directory(staging_path_, ec) || ec) {
     throw RuntimeError("cannot create " + staging_path_.string() + ": " + ec.message());
   }
-  std::lock_guard lock(StagingMutex());
-  StagingSet().insert(staging_path_.string());
 }
 
 StagingDir::~StagingDir() {
@@ -73,8 +56,6 @@ StagingDir::~StagingDir() {
     std::error_code ec;
     fs::remove_all(staging_path_, ec);
   }
-  std::lock_guard lock(StagingMutex());
-  StagingSet().erase(staging_path_.string());
 }
 
 void StagingDir::Commit() {
@@ -91,15 +72,6 @@ void StagingDir::Commit() {
   if (ec) throw RuntimeError("cannot rename into " + final_path_.string() + ": " + ec.message());
   committed_ = true;
   if (!old.empty()) fs::remove_all(old, ec);
-}
-
-void RemoveStagingDirsOfThisProcess() {
-  // Called from normal code paths after a cancel; not async-signal-safe.
-  std::lock_guard lock(StagingMutex());
-  for (const std::string& dir : StagingSet()) {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
 }
 
 uint64_t Fnv1a64(std::string_view bytes, uint64_t seed) {

@@ -37,10 +37,6 @@ class StagingDir {
   bool committed_ = false;
 };
 
-// Removes every `.partial-<pid>` staging folder of this process (for signal
-// handlers that must exit at once).
-void RemoveStagingDirsOfThisProcess();
-
 // SHA-256-free content hash for caching and tests: 64-bit FNV-1a.
 uint64_t Fnv1a64(std::string_view bytes, uint64_t seed = 1469598103934665603ull);
 

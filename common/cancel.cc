@@ -1,7 +1,5 @@
 #include "common/cancel.h"
 
-#include <unistd.h>
-
 #include <atomic>
 #include <csignal>
 
@@ -12,10 +10,10 @@ namespace {
 
 volatile std::sig_atomic_t g_cancel = 0;
 
-void OnSignal(int signal) {
-  if (g_cancel != 0) _exit(128 + signal);  // a second Ctrl-C: give up at once
-  g_cancel = 1;
-}
+// Loops poll the flag at least once per camera render (tens of milliseconds),
+// so a single signal ends a run promptly and cleanly; further signals change
+// nothing, so an impatient second Ctrl-C cannot leave a staging folder behind.
+void OnSignal(int) { g_cancel = 1; }
 
 }  // namespace
 

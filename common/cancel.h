@@ -5,7 +5,7 @@
 
 namespace irbench {
 
-// Installs handlers for SIGINT and SIGTERM. A second signal exits at once.
+// Installs handlers for SIGINT and SIGTERM.
 void InstallCancelHandlers();
 bool CancelRequested();
 // Throws Cancelled if a signal arrived.

@@ -113,7 +113,7 @@ void SetupVertexLayout(const GlFunctions& gl) {
 }  // namespace
 
 void RenderOptions::Check() const {
-  if (supersample < 1 || supersample > 8) throw InputError("", "supersample", "must be in 1..8");
+  if (supersample < 1 || supersample > 4) throw InputError("", "supersample", "must be in 1..4");
   if (near_m <= 0 || far_m <= near_m) throw InputError("", "near_m", "need 0 < near < far");
 }
 
@@ -121,7 +121,7 @@ struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
   cv::Mat map_x, map_y;  // output pixel -> render pixel
-  cv::Mat raw_grey, raw_mask, raw_depth, blurred_grey;
+  cv::Mat raw_grey, raw_mask, raw_depth, blurred_grey, blurred_mask;
   Eigen::Matrix4f clip_from_world;
 };
 
@@ -363,8 +363,16 @@ void Renderer::Render(int index, CameraImages* out, bool want_depth) {
   // to them; this keeps sub-pixel corner positions unbiased and steady.
   cv::GaussianBlur(t.raw_grey, t.blurred_grey, cv::Size(0, 0), 0.5 * options_.supersample);
   cv::remap(t.blurred_grey, out->grey, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  // At supersample 2 a bilinear sample at an output pixel centre is exactly the
+  // mean of its 2x2 block (the coverage); otherwise a symmetric Gaussian
+  // prefilter makes the 50% level fall on the true edge.
   cv::Mat coverage;
-  cv::remap(t.raw_mask, coverage, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  const cv::Mat* mask_source = &t.raw_mask;
+  if (options_.supersample != 2) {
+    cv::GaussianBlur(t.raw_mask, t.blurred_mask, cv::Size(0, 0), 0.5 * options_.supersample);
+    mask_source = &t.blurred_mask;
+  }
+  cv::remap(*mask_source, coverage, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   cv::threshold(coverage, out->mask, 127, 255, cv::THRESH_BINARY);
   if (want_depth) {
     cv::remap(t.raw_depth, out->depth, t.map_x, t.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT);

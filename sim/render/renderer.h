@@ -3,7 +3,7 @@
 // with three targets (grey shading, person mask, camera depth), at a
 // supersampled pinhole resolution wide enough to cover the distorted image,
 // then resampled through the camera's exact Brown–Conrady distortion on the
-// CPU. The person mesh is uploaded once per frame and drawn by every camera.
+// CPU (docs/truth.md). The person mesh is uploaded once per frame and drawn by every camera.
 
 #include <Eigen/Core>
 #include <memory>

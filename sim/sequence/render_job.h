@@ -1,6 +1,6 @@
 #pragma once
 // `irbench render`: load a scene, rig, avatar and motion; render every camera
-// for every frame; write a sequence folder (docs/sequence-format.md) under a
+// for every frame; write a sequence folder (docs/architecture.md) under a
 // staging name and rename it into place when complete.
 
 #include <filesystem>
