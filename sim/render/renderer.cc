@@ -315,6 +315,20 @@ void Renderer::UpdatePerson(const std::vector<MeshVertex>& vertices) {
 }
 
 void Renderer::Render(int index, CameraImages* out, bool want_depth) {
+  Draw(index);
+  Read(index, out, want_depth);
+}
+
+void Renderer::RenderAll(std::vector<CameraImages>* out, bool want_depth) {
+  // Issue every camera's draw first: llvmpipe rasterises a framebuffer's scene
+  // on its worker threads once the next framebuffer is bound, so the read-back
+  // and resampling of one camera overlap the rasterisation of the others.
+  out->resize(targets_.size());
+  for (size_t i = 0; i < targets_.size(); ++i) Draw(static_cast<int>(i));
+  for (size_t i = 0; i < targets_.size(); ++i) Read(static_cast<int>(i), &(*out)[i], want_depth);
+}
+
+void Renderer::Draw(int index) {
   const GlFunctions& gl = gl_;
   Target& t = *targets_.at(index);
   const Camera& rc = t.render_camera;
@@ -346,6 +360,13 @@ void Renderer::Render(int index, CameraImages* out, bool want_depth) {
     gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
   }
   gl.BindVertexArray(0);
+}
+
+void Renderer::Read(int index, CameraImages* out, bool want_depth) {
+  const GlFunctions& gl = gl_;
+  Target& t = *targets_.at(index);
+  const Camera& rc = t.render_camera;
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_UNSIGNED_BYTE, t.raw_grey.data);

@@ -54,6 +54,8 @@ class Renderer {
 
   // Renders camera `index`; `out->depth` is filled only when `want_depth`.
   void Render(int index, CameraImages* out, bool want_depth);
+  // Renders every camera, (*out)[i] for camera i; faster than one at a time.
+  void RenderAll(std::vector<CameraImages>* out, bool want_depth);
 
   // Visibility of a world point in camera `index`, from that camera's last
   // render: kOutside when it projects outside the image (or behind the camera);
@@ -71,6 +73,8 @@ class Renderer {
 
  private:
   struct Target;
+  void Draw(int index);
+  void Read(int index, CameraImages* out, bool want_depth);
   GlContext& context_;
   const GlFunctions& gl_;
   std::vector<Camera> cameras_;

@@ -27,7 +27,7 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
     renderer.SetScene(in.scene);
     renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
     std::vector<MeshVertex> skinned;
-    CameraImages images;
+    std::vector<CameraImages> images;
     RenderBenchResult result;
     result.label = std::to_string(cameras[0].width) + "x" + std::to_string(cameras[0].height);
     result.cameras = static_cast<int>(cameras.size());
@@ -41,10 +41,10 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
         ThrowIfCancelled();
         const double t = std::max(0, f) / in.fps;
         const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);
-        for (size_t c = 0; c < cameras.size(); ++c) {
-          renderer.Render(static_cast<int>(c), &images, false);
-          if (encode) {
-            volatile size_t sink = EncodePng(images.grey).size() + EncodePng(images.mask).size();
+        renderer.RenderAll(&images, false);
+        if (encode) {
+          for (const CameraImages& image : images) {
+            volatile size_t sink = EncodePng(image.grey).size() + EncodePng(image.mask).size();
             (void)sink;
           }
         }

@@ -201,13 +201,14 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   };
 
   // 4. Empty-stage frames.
-  CameraImages images;
+  std::vector<CameraImages> all_images;
   renderer.SetPersonVisible(false);
   for (int f = 0; f < options.background_frames; ++f) {
     ThrowIfCancelled();
+    renderer.RenderAll(&all_images, false);
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      renderer.Render(static_cast<int>(c), &images, false);
-      WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), images.grey);
+      WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"),
+                     all_images[c].grey);
     }
     ++done;
     report("background", f, options.background_frames);
@@ -222,13 +223,14 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     ThrowIfCancelled();
     const double t = f / in.fps;
     const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);
+    renderer.RenderAll(&all_images, options.write_depth);
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const std::string& cam_name = in.rig.cameras[c].name;
-      renderer.Render(static_cast<int>(c), &images, options.write_depth);
-      WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), images.grey);
-      WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), images.mask);
+      WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), all_images[c].grey);
+      WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);
       if (options.write_depth) {
-        WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"), images.depth);
+        WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"),
+                            all_images[c].depth);
       }
     }
     const FrameTruth truth = ComputeFrameTruth(in, world_from_joint, renderer);
