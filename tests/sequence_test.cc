@@ -2,6 +2,10 @@
 // truth pixel with OpenCV, visible joints lie on the person, renders are
 // byte-identical for the same inputs.
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -111,6 +115,60 @@ TEST_P(SequenceTest, CalibrationReproducesTruthPixelsAndVisibleJointsLieOnThePer
 INSTANTIATE_TEST_SUITE_P(Rigs, SequenceTest,
                          ::testing::Values("theater4", "theater5", "flatworld4", "lab4"));
 
+cv::Mat ReadDepthExr(const fs::path& path) {
+  Imf::InputFile file(path.c_str());
+  const Imath::Box2i window = file.header().dataWindow();
+  cv::Mat depth(window.max.y - window.min.y + 1, window.max.x - window.min.x + 1, CV_32FC1);
+  Imf::FrameBuffer frame_buffer;
+  frame_buffer.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(depth.data), sizeof(float),
+                                      sizeof(float) * depth.cols));
+  file.setFrameBuffer(frame_buffer);
+  file.readPixels(window.min.y, window.max.y);
+  return depth;
+}
+
+// The depth EXR opens with OpenEXR and, at every visible joint, holds the
+// camera depth of a surface just in front of that joint.
+TEST(SequenceDepthTest, ExrDepthAgreesWithTruthJoints) {
+  const fs::path dir = FreshTempDir("seq_depth");
+  const fs::path seq = RenderFast("theater4", GlBackend::kAuto, dir, "seq");
+  cv::FileStorage extri((seq / "calib/extri.yml").string(), cv::FileStorage::READ);
+  std::ifstream truth(seq / "truth/frames.jsonl");
+  std::string line;
+  int checked = 0;
+  while (std::getline(truth, line)) {
+    const auto frame = nlohmann::json::parse(line);
+    char file[32];
+    std::snprintf(file, sizeof(file), "%06d.exr", int(frame["frame"]));
+    for (const auto& [cam, joints] : frame["joints2d"].items()) {
+      const cv::Mat depth = ReadDepthExr(seq / "truth/depth" / cam / file);
+      ASSERT_EQ(depth.cols, 320);
+      cv::Mat rot, tvec;
+      extri["Rot_" + cam] >> rot;
+      extri["T_" + cam] >> tvec;
+      for (const auto& [joint, uvv] : joints.items()) {
+        if (int(uvv[2]) != 2 || joint == "root") continue;
+        const auto& p = frame["joints3d"][joint];
+        const cv::Mat p_in_cam = rot * (cv::Mat_<double>(3, 1) << p[0], p[1], p[2]) + tvec;
+        // Within one pixel of the joint, some surface seen lies in front of it
+        // by less than a body radius (the visibility rule, docs/truth.md).
+        const int u = int(std::lround(double(uvv[0]))), v = int(std::lround(double(uvv[1])));
+        bool found = false;
+        for (int dv = -1; dv <= 1; ++dv) {
+          for (int du = -1; du <= 1; ++du) {
+            if (u + du < 0 || v + dv < 0 || u + du >= depth.cols || v + dv >= depth.rows) continue;
+            const double in_front = p_in_cam.at<double>(2) - depth.at<float>(v + dv, u + du);
+            found = found || (in_front > -0.05 && in_front < 0.2);
+          }
+        }
+        EXPECT_TRUE(found) << cam << " " << joint;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
 std::map<std::string, uint64_t> HashTree(const fs::path& root) {
   std::map<std::string, uint64_t> hashes;
   for (const auto& e : fs::recursive_directory_iterator(root)) {
@@ -124,7 +182,7 @@ std::map<std::string, uint64_t> HashTree(const fs::path& root) {
 class DeterminismTest : public ::testing::TestWithParam<GlBackend> {};
 
 TEST_P(DeterminismTest, SameInputsGiveByteIdenticalFiles) {
-  const fs::path dir = FreshTempDir(GetParam() == GlBackend::kEgl ? "det_egl" : "det_osmesa");
+  const fs::path dir = FreshTempDir("det_" + GlBackendName(GetParam()));
   const auto a = HashTree(RenderFast("theater4", GetParam(), dir, "a"));
   const auto b = HashTree(RenderFast("theater4", GetParam(), dir, "b"));
   ASSERT_GT(a.size(), 50u);
@@ -133,10 +191,7 @@ TEST_P(DeterminismTest, SameInputsGiveByteIdenticalFiles) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, DeterminismTest,
                          ::testing::Values(GlBackend::kEgl, GlBackend::kOsMesa),
-                         [](const auto& info) {
-                           return info.param == GlBackend::kEgl ? std::string("egl")
-                                                                : std::string("osmesa");
-                         });
+                         [](const auto& info) { return GlBackendName(info.param); });
 
 }  // namespace
 }  // namespace irbench

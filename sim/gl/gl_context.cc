@@ -15,6 +15,18 @@ std::optional<GlBackend> ParseGlBackend(const std::string& name) {
   return std::nullopt;
 }
 
+std::string GlBackendName(GlBackend backend) {
+  switch (backend) {
+    case GlBackend::kEgl:
+      return "egl";
+    case GlBackend::kOsMesa:
+      return "osmesa";
+    case GlBackend::kAuto:
+      break;
+  }
+  return "auto";
+}
+
 std::string GlContext::RendererString() const {
   auto str = [&](GLenum e) {
     const GLubyte* s = gl_.GetString(e);

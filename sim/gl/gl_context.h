@@ -18,6 +18,8 @@ enum class GlBackend { kAuto, kEgl, kOsMesa };
 
 // Parses "auto" | "egl" | "osmesa"; nullopt otherwise.
 std::optional<GlBackend> ParseGlBackend(const std::string& name);
+// "auto", "egl" or "osmesa".
+std::string GlBackendName(GlBackend backend);
 
 class GlContext {
  public:

@@ -26,6 +26,9 @@ TEST(GlContextTest, ParseBackend) {
   EXPECT_EQ(ParseGlBackend("osmesa"), GlBackend::kOsMesa);
   EXPECT_EQ(ParseGlBackend("auto"), GlBackend::kAuto);
   EXPECT_FALSE(ParseGlBackend("vulkan").has_value());
+  for (GlBackend b : {GlBackend::kAuto, GlBackend::kEgl, GlBackend::kOsMesa}) {
+    EXPECT_EQ(ParseGlBackend(GlBackendName(b)), b);
+  }
 }
 
 }  // namespace

@@ -144,10 +144,7 @@ TEST_P(RendererTest, CheckerboardCalibrationRecoversTheRig) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, RendererTest,
                          ::testing::Values(GlBackend::kEgl, GlBackend::kOsMesa),
-                         [](const auto& info) {
-                           return info.param == GlBackend::kEgl ? std::string("egl")
-                                                                : std::string("osmesa");
-                         });
+                         [](const auto& info) { return GlBackendName(info.param); });
 
 }  // namespace
 }  // namespace irbench
