@@ -349,15 +349,16 @@ void Renderer::Draw(int index) {
   const Eigen::Vector3f center = rc.CenterInWorld().cast<float>();
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_camera_center"), 1, center.data());
   const GLint person_loc = gl.GetUniformLocation(program_, "u_person");
-  if (static_index_count_ > 0) {
-    gl.Uniform1f(person_loc, 0.0f);
-    gl.BindVertexArray(static_vao_);
-    gl.DrawElements(GL_TRIANGLES, static_index_count_, GL_UNSIGNED_INT, nullptr);
-  }
+  // Near to far: the person, then the scene (rooms last), for early depth rejection.
   if (person_visible_ && person_index_count_ > 0) {
     gl.Uniform1f(person_loc, 1.0f);
     gl.BindVertexArray(person_vao_);
     gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
+  }
+  if (static_index_count_ > 0) {
+    gl.Uniform1f(person_loc, 0.0f);
+    gl.BindVertexArray(static_vao_);
+    gl.DrawElements(GL_TRIANGLES, static_index_count_, GL_UNSIGNED_INT, nullptr);
   }
   gl.BindVertexArray(0);
 }

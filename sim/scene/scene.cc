@@ -103,6 +103,9 @@ Scene LoadScene(const std::filesystem::path& path) {
   scene.ambient = root.GetDouble("ambient", 0.3);
   if (scene.ambient < 0) root["ambient"].Fail("must be non-negative");
 
+  // Rooms enclose everything; they go last in the mesh so that the renderer's
+  // depth test rejects their hidden fragments early instead of shading them.
+  TriangleMesh enclosure;
   if (root.Has("objects")) {
     const JsonNode objects = root["objects"];
     for (size_t i = 0; i < objects.Size(); ++i) {
@@ -112,7 +115,7 @@ Scene LoadScene(const std::filesystem::path& path) {
         o.CheckKeys({"type", "name", "min", "max", "floor", "ceiling", "walls"});
         const Eigen::Vector3d min = o.GetVec3("min"), max = o.GetVec3("max");
         CheckBox(o, min, max);
-        AppendRoom(scene.mesh, min, max, ReadMaterial(o, "floor", 0.3f),
+        AppendRoom(enclosure, min, max, ReadMaterial(o, "floor", 0.3f),
                    ReadMaterial(o, "ceiling", 0.2f), ReadMaterial(o, "walls", 0.25f));
       } else if (type == "box") {
         o.CheckKeys({"type", "name", "min", "max", "albedo"});
@@ -162,6 +165,7 @@ Scene LoadScene(const std::filesystem::path& path) {
       scene.lights.push_back(light);
     }
   }
+  scene.mesh.Append(enclosure);
   if (scene.mesh.vertices.empty()) root.Fail("scene has no geometry");
   return scene;
 }

@@ -33,8 +33,9 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
     result.cameras = static_cast<int>(cameras.size());
     result.frames = frames;
     for (bool encode : {false, true}) {
-      // One warm-up frame-set, then the timed ones.
-      for (int f = -1; f < frames; ++f) {
+      // Five warm-up frame-sets (shader variants compile on first use), then
+      // the timed ones.
+      for (int f = -5; f < frames; ++f) {
         if (f == 0) Log().debug("bench: timing {} encode={}", result.label, encode);
         static thread_local std::chrono::steady_clock::time_point start;
         if (f == 0) start = std::chrono::steady_clock::now();
