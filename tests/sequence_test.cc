@@ -26,7 +26,7 @@ using irbench::testing::ReadText;
 using irbench::testing::WriteText;
 
 fs::path RenderFast(const std::string& rig, GlBackend backend, const fs::path& dir,
-                    const std::string& name) {
+                    const std::string& name, const std::string& sensor = "clean", uint64_t seed = 1) {
   const fs::path motion = dir / "fast.json";
   WriteText(motion, irbench::testing::FastMotionJson());
   RenderJobOptions options;
@@ -37,6 +37,8 @@ fs::path RenderFast(const std::string& rig, GlBackend backend, const fs::path& d
   options.out = dir / name;
   options.backend = backend;
   options.write_depth = true;
+  options.sensor = sensor;
+  options.seed = seed;
   return RunRenderJob(options);
 }
 
@@ -187,6 +189,26 @@ TEST_P(DeterminismTest, SameInputsGiveByteIdenticalFiles) {
   const auto b = HashTree(RenderFast("theater4", GetParam(), dir, "b"));
   ASSERT_GT(a.size(), 50u);
   EXPECT_EQ(a, b);
+}
+
+// With the sensor model on, the seed decides every noise field: the same seed
+// gives the same bytes, another seed other frames; masks and truth joints do
+// not depend on the sensor.
+TEST(SensorSequenceTest, SeedDecidesTheNoise) {
+  const fs::path dir = FreshTempDir("seq_sensor");
+  const auto a = HashTree(RenderFast("theater4", GlBackend::kAuto, dir, "a", "thesis", 3));
+  const auto b = HashTree(RenderFast("theater4", GlBackend::kAuto, dir, "b", "thesis", 3));
+  const auto c = HashTree(RenderFast("theater4", GlBackend::kAuto, dir, "c", "thesis", 4));
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a.at("frames/side/000003.png"), c.at("frames/side/000003.png"));
+  EXPECT_NE(a.at("background/side/000001.png"), c.at("background/side/000001.png"));
+  EXPECT_EQ(a.at("truth/masks/side/000003.png"), c.at("truth/masks/side/000003.png"));
+  // The frames are grainy: two empty-stage frames of one camera differ.
+  const cv::Mat bg0 = cv::imread((dir / "a/background/side/000000.png").string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat bg1 = cv::imread((dir / "a/background/side/000001.png").string(), cv::IMREAD_UNCHANGED);
+  EXPECT_GT(cv::norm(bg0, bg1, cv::NORM_L1) / bg0.total(), 0.2);
+  const auto truth = nlohmann::json::parse(ReadText(dir / "a/truth/background.jsonl").substr(0, ReadText(dir / "a/truth/background.jsonl").find('\n')));
+  EXPECT_TRUE(truth["sensor"]["side"].contains("flicker"));
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, DeterminismTest,

@@ -46,7 +46,7 @@ Rig LoadRig(const std::filesystem::path& path) {
   for (size_t i = 0; i < cameras.Size(); ++i) {
     const JsonNode c = cameras[i];
     c.CheckKeys({"name", "width", "height", "fx", "fy", "cx", "cy", "dist", "position", "look_at",
-                 "up", "fps", "exposure_ms", "description"});
+                 "up", "fps", "exposure_ms", "sensor", "description"});
     Camera cam;
     cam.name = c.GetString("name");
     if (cam.name.empty() || cam.name.find_first_of("/ \t") != std::string::npos) {
@@ -84,6 +84,7 @@ Rig LoadRig(const std::filesystem::path& path) {
       c["exposure_ms"].Fail("must be positive and at most the frame period");
     }
     rig.cameras.push_back(cam);
+    rig.sensor_overrides.push_back(c.Has("sensor") ? c["sensor"].raw() : nlohmann::json());
   }
   return rig;
 }

@@ -3,6 +3,7 @@
 // pose as position + look-at + up, fps and exposure. Format in docs/formats.md.
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,9 @@ struct Rig {
   std::string name;
   std::string scene;  // the scene the rig was designed for (default for --scene)
   std::vector<Camera> cameras;
+  // Per camera, the "sensor" object of the rig file (knob overrides of the
+  // sensor preset: {"sensor": {...}, "flicker": {...}}), or null.
+  std::vector<nlohmann::json> sensor_overrides;
   std::filesystem::path source;
 };
 

@@ -48,14 +48,15 @@ std::string ExtriYaml(const std::vector<Camera>& cameras) {
   return fs.releaseAndGetString();
 }
 
-nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::string& sensor_preset) {
+nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::vector<SensorSetup>& sensors) {
   nlohmann::json j;
   j["format"] = "irbench.cameras/1";
   j["convention"] =
       "OpenCV pinhole + Brown-Conrady (k1 k2 p1 p2 k3); pixel (0,0) is the centre of the top-left "
       "pixel; R and T are cam_from_world, world in metres, z up";
   j["cameras"] = nlohmann::json::array();
-  for (const Camera& cam : cameras) {
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& cam = cameras[i];
     nlohmann::json c;
     c["name"] = cam.name;
     c["width"] = cam.width;
@@ -70,7 +71,9 @@ nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::string
     c["center_in_world"] = {center.x(), center.y(), center.z()};
     c["fps"] = cam.fps;
     c["exposure_ms"] = cam.exposure_ms;
-    c["sensor"] = {{"preset", sensor_preset}, {"bit_depth", 8}};
+    c["sensor"] = {{"preset", sensors[i].preset},
+                   {"emva1288", sensors[i].sensor.ToJson()},
+                   {"flicker", sensors[i].flicker.ToJson()}};
     j["cameras"].push_back(c);
   }
   return j;

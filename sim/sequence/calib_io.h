@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim/camera/camera.h"
+#include "sim/sensor/sensor_model.h"
 
 namespace irbench {
 
@@ -16,6 +17,6 @@ std::string IntriYaml(const std::vector<Camera>& cameras);
 // all cam_from_world.
 std::string ExtriYaml(const std::vector<Camera>& cameras);
 // cameras.json: the same plus image size, fps, exposure, sensor parameters.
-nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::string& sensor_preset);
+nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::vector<SensorSetup>& sensors);
 
 }  // namespace irbench

@@ -11,6 +11,7 @@
 #include "common/paths.h"
 #include "sim/sequence/calib_io.h"
 #include "sim/sequence/image_io.h"
+#include "sim/sensor/flicker.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -41,10 +42,9 @@ nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   RenderInputs in;
-  if (options.sensor != "clean") {
-    throw InputError("", "--sensor",
-                     "unknown preset '" + options.sensor +
-                         "' (available: clean; 'thesis' and 'harsh' arrive with the sensor model)");
+  const auto preset = SensorPreset(options.sensor);
+  if (!preset) {
+    throw InputError("", "--sensor", "unknown preset '" + options.sensor + "' (clean, thesis, harsh)");
   }
   if (options.frames && (*options.frames < 1 || *options.frames > 1000000)) {
     throw InputError("", "--frames", "must be in 1..1000000");
@@ -72,6 +72,16 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
       throw InputError(in.rig_file.string(), "cameras[" + std::to_string(i) + "].fps",
                        "differs from cameras[0].fps; per-camera clocks are not supported yet");
     }
+  }
+  for (size_t i = 0; i < in.rig.cameras.size(); ++i) {
+    SensorSetup setup = *preset;
+    const nlohmann::json& overrides = in.rig.sensor_overrides[i];
+    if (!overrides.is_null()) {
+      ApplySensorOverrides(overrides, in.rig_file.string(), "cameras[" + std::to_string(i) + "].sensor",
+                           &setup);
+    }
+    in.sensor_active.push_back(options.sensor != "clean" || !overrides.is_null());
+    in.sensors.push_back(setup);
   }
   in.frame_count = options.frames.value_or(
       static_cast<int>(std::floor(in.motion->duration() * in.fps + 1e-9)) + 1);
@@ -152,7 +162,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   AtomicWriteFile(root / "calib" / "intri.yml", IntriYaml(in.rig.cameras));
   AtomicWriteFile(root / "calib" / "extri.yml", ExtriYaml(in.rig.cameras));
   AtomicWriteFile(root / "calib" / "cameras.json",
-                  CamerasJson(in.rig.cameras, options.sensor).dump(2) + "\n");
+                  CamerasJson(in.rig.cameras, in.sensors).dump(2) + "\n");
   AtomicWriteFile(root / "calib" / "screens.json", in.scene.ScreensJson().dump(2) + "\n");
 
   nlohmann::json manifest;
@@ -184,7 +194,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["files"] = {{"frames", "frames/<cam>/NNNNNN.png"},
                        {"background", "background/<cam>/NNNNNN.png"},
                        {"masks", "truth/masks/<cam>/NNNNNN.png"},
-                       {"truth", "truth/frames.jsonl"}};
+                       {"truth", "truth/frames.jsonl"},
+                       {"background_truth", "truth/background.jsonl"}};
   if (options.write_depth) manifest["files"]["depth"] = "truth/depth/<cam>/NNNNNN.exr";
 
   const auto start = std::chrono::steady_clock::now();
@@ -200,16 +211,46 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
                elapsed > 0 ? done / elapsed : 0.0);
   };
 
+  // The sensor model per camera; background frames come before t = 0.
+  const double background_s = options.background_frames / in.fps;
+  std::vector<SensorModel> sensors;
+  std::vector<FlickerModel> flickers;
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    const Camera& cam = in.rig.cameras[c];
+    sensors.emplace_back(in.sensors[c].sensor, options.seed, cam.name, cam.width, cam.height);
+    flickers.emplace_back(in.sensors[c].flicker, options.seed, -background_s,
+                          in.frame_count / in.fps);
+  }
+  // Turns the clean render of camera c into the written frame; records the
+  // frame's illumination level and exposure in `sensor_truth`.
+  cv::Mat radiance;
+  auto expose = [&](size_t c, const cv::Mat& grey, double t, uint64_t noise_frame,
+                    nlohmann::json& sensor_truth) -> cv::Mat {
+    const Camera& cam = in.rig.cameras[c];
+    if (!in.sensor_active[c]) {
+      sensor_truth[cam.name] = {{"flicker", 1.0}, {"exposure_ms", cam.exposure_ms}};
+      return grey;
+    }
+    const double level = flickers[c].Level(t, cam.exposure_ms / 1000.0);
+    sensor_truth[cam.name] = {{"flicker", level}, {"exposure_ms", cam.exposure_ms}};
+    grey.convertTo(radiance, CV_32F, level / 255.0);
+    return sensors[c].ToOutput(sensors[c].Expose(radiance, cam.exposure_ms, noise_frame));
+  };
+
   // 4. Empty-stage frames.
   std::vector<CameraImages> all_images;
+  std::string background_lines;
   renderer.SetPersonVisible(false);
   for (int f = 0; f < options.background_frames; ++f) {
     ThrowIfCancelled();
     renderer.RenderAll(&all_images, false);
+    const double t = f / in.fps - background_s;
+    nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"),
-                     all_images[c].grey);
+      const cv::Mat frame = expose(c, all_images[c].grey, t, (1ull << 40) + f, sensor_truth);
+      WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }
+    background_lines += nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";
     ++done;
     report("background", f, options.background_frames);
   }
@@ -224,9 +265,11 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     const double t = f / in.fps;
     const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);
     renderer.RenderAll(&all_images, options.write_depth);
+    nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const std::string& cam_name = in.rig.cameras[c].name;
-      WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), all_images[c].grey);
+      const cv::Mat frame = expose(c, all_images[c].grey, t, f, sensor_truth);
+      WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
       WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);
       if (options.write_depth) {
         WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"),
@@ -256,11 +299,13 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     line["joints2d"] = joints2d;
     line["labels"] = {{"gesture", nullptr}, {"posture", nullptr}, {"rest", nullptr}, {"motion", nullptr}};
     line["pointing"] = {{"left", nullptr}, {"right", nullptr}};
+    line["sensor"] = sensor_truth;
     truth_lines += line.dump() + "\n";
     ++done;
     report("frame", f, in.frame_count);
   }
   AtomicWriteFile(root / "truth" / "frames.jsonl", truth_lines);
+  AtomicWriteFile(root / "truth" / "background.jsonl", background_lines);
   AtomicWriteFile(root / "manifest.json", manifest.dump(2) + "\n");
   ThrowIfCancelled();
   staging.Commit();

@@ -14,6 +14,7 @@
 #include "sim/gl/gl_context.h"
 #include "sim/render/renderer.h"
 #include "sim/scene/scene.h"
+#include "sim/sensor/sensor_model.h"
 
 namespace irbench {
 
@@ -43,6 +44,9 @@ struct RenderInputs {
   std::filesystem::path scene_file, rig_file, avatar_file, motion_file;
   int frame_count = 0;
   double fps = 30;
+  // Per camera: the sensor preset with the rig's per-knob overrides.
+  std::vector<SensorSetup> sensors;
+  std::vector<bool> sensor_active;  // false: the clean render is written as is
 };
 
 RenderInputs LoadRenderInputs(const RenderJobOptions& options);

@@ -1,0 +1,280 @@
+#include "sim/sensor/sensor_model.h"
+
+#include <cmath>
+
+#include "common/error.h"
+
+namespace irbench {
+
+uint64_t MixHash(uint64_t a, uint64_t b) {
+  // SplitMix64 finaliser over a combination of the two words.
+  uint64_t z = a * 0x9E3779B97F4A7C15ull + b + 0x632BE59BD9B4E019ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+void StandardNormalPair(uint64_t counter, float* z0, float* z1) {
+  const uint64_t bits = MixHash(counter, 0xD1B54A32D192ED03ull);
+  // Two 32-bit uniforms in (0, 1].
+  const double u1 = (double(bits >> 32) + 1.0) / 4294967296.0;
+  const double u2 = double(bits & 0xFFFFFFFFull) / 4294967296.0;
+  const double r = std::sqrt(-2.0 * std::log(u1));
+  const double phi = 2.0 * M_PI * u2;
+  *z0 = static_cast<float>(r * std::cos(phi));
+  *z1 = static_cast<float>(r * std::sin(phi));
+}
+
+namespace {
+
+void CheckRange(double value, double lo, double hi, const std::string& file, const std::string& field) {
+  if (!(value >= lo && value <= hi)) {
+    throw InputError(file, field,
+                     "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " +
+                         std::to_string(value) + ")");
+  }
+}
+
+uint64_t StringHash(const std::string& s) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+void SensorParams::Check(const std::string& file, const std::string& p) const {
+  CheckRange(photons_per_ms, 0, 1e9, file, p + "photons_per_ms");
+  CheckRange(quantum_efficiency, 0, 1, file, p + "quantum_efficiency");
+  CheckRange(full_well_e, 1, 1e7, file, p + "full_well_e");
+  CheckRange(system_gain_dn_per_e, 1e-6, 1e3, file, p + "system_gain_dn_per_e");
+  CheckRange(dark_noise_e, 0, 1e4, file, p + "dark_noise_e");
+  CheckRange(dark_current_e_per_s, 0, 1e7, file, p + "dark_current_e_per_s");
+  CheckRange(dsnu_e, 0, 1e4, file, p + "dsnu_e");
+  CheckRange(prnu, 0, 0.5, file, p + "prnu");
+  CheckRange(bit_depth, 8, 16, file, p + "bit_depth");
+  CheckRange(black_level_dn, 0, (1 << bit_depth) - 1, file, p + "black_level_dn");
+  CheckRange(tone_lift, 0, 0.9, file, p + "tone_lift");
+  CheckRange(tone_ceiling_drop, 0, 0.9 - tone_lift, file, p + "tone_ceiling_drop");
+  CheckRange(tone_gamma, 0.1, 10, file, p + "tone_gamma");
+}
+
+nlohmann::json SensorParams::ToJson() const {
+  return {{"photons_per_ms", photons_per_ms},
+          {"quantum_efficiency", quantum_efficiency},
+          {"full_well_e", full_well_e},
+          {"system_gain_dn_per_e", system_gain_dn_per_e},
+          {"dark_noise_e", dark_noise_e},
+          {"dark_current_e_per_s", dark_current_e_per_s},
+          {"dsnu_e", dsnu_e},
+          {"prnu", prnu},
+          {"bit_depth", bit_depth},
+          {"black_level_dn", black_level_dn},
+          {"tone_lift", tone_lift},
+          {"tone_ceiling_drop", tone_ceiling_drop},
+          {"tone_gamma", tone_gamma},
+          {"noise", noise}};
+}
+
+void FlickerParams::Check(const std::string& file, const std::string& p) const {
+  CheckRange(screen_amplitude, 0, 1, file, p + "screen_amplitude");
+  CheckRange(cut_rate_hz, 0, 100, file, p + "cut_rate_hz");
+  CheckRange(fade_s, 0, 10, file, p + "fade_s");
+  CheckRange(flash_rate_hz, 0, 100, file, p + "flash_rate_hz");
+  CheckRange(flash_gain, 0, 10, file, p + "flash_gain");
+  CheckRange(flash_s, 0, 10, file, p + "flash_s");
+  CheckRange(mains_hz, 0, 100000, file, p + "mains_hz");
+  CheckRange(mains_depth, 0, 1, file, p + "mains_depth");
+}
+
+nlohmann::json FlickerParams::ToJson() const {
+  return {{"screen_amplitude", screen_amplitude}, {"cut_rate_hz", cut_rate_hz},
+          {"fade_s", fade_s},                     {"flash_rate_hz", flash_rate_hz},
+          {"flash_gain", flash_gain},             {"flash_s", flash_s},
+          {"mains_hz", mains_hz},                 {"mains_depth", mains_depth}};
+}
+
+std::optional<SensorSetup> SensorPreset(const std::string& name) {
+  SensorSetup s;
+  s.preset = name;
+  if (name == "clean") {
+    s.sensor.noise = false;
+    s.sensor.dark_current_e_per_s = 0;
+    s.sensor.dsnu_e = 0;
+    s.sensor.prnu = 0;
+    s.sensor.black_level_dn = 0;
+    // Radiance 1 at 10 ms exposure fills the 8-bit range exactly.
+    s.sensor.quantum_efficiency = 1.0;
+    s.sensor.photons_per_ms = 255.0 / (0.04 * 10.0);
+    s.sensor.full_well_e = 1e7;
+    return s;
+  }
+  if (name == "thesis") {
+    // Thesis 1.2: very dark, illumination that changes with the screen's
+    // content, washed out with a limited grey range, grainy.
+    s.sensor = SensorParams{};
+    s.sensor.tone_lift = 0.12;
+    s.sensor.tone_ceiling_drop = 0.35;
+    s.sensor.tone_gamma = 0.8;
+    s.flicker.screen_amplitude = 0.08;
+    s.flicker.cut_rate_hz = 0.5;
+    s.flicker.flash_rate_hz = 0.1;
+    s.flicker.mains_depth = 0.05;
+    return s;
+  }
+  if (name == "harsh") {
+    s.sensor = SensorParams{};
+    s.sensor.photons_per_ms = 1000.0;
+    s.sensor.dark_noise_e = 20.0;
+    s.sensor.dark_current_e_per_s = 150.0;
+    s.sensor.dsnu_e = 15.0;
+    s.sensor.prnu = 0.03;
+    s.sensor.tone_lift = 0.2;
+    s.sensor.tone_ceiling_drop = 0.4;
+    s.sensor.tone_gamma = 0.7;
+    s.flicker.screen_amplitude = 0.2;
+    s.flicker.cut_rate_hz = 1.5;
+    s.flicker.flash_rate_hz = 0.4;
+    s.flicker.mains_depth = 0.15;
+    return s;
+  }
+  return std::nullopt;
+}
+
+void ApplySensorOverrides(const nlohmann::json& overrides,
+                          const std::string& file,
+                          const std::string& prefix,
+                          SensorSetup* setup) {
+  if (!overrides.is_object()) throw InputError(file, prefix, "expected an object");
+  for (const auto& [group, knobs] : overrides.items()) {
+    const std::string group_field = prefix + "." + group;
+    if (group != "sensor" && group != "flicker") {
+      throw InputError(file, group_field, "unknown group (sensor, flicker)");
+    }
+    if (!knobs.is_object()) throw InputError(file, group_field, "expected an object");
+    nlohmann::json merged =
+        group == "sensor" ? setup->sensor.ToJson() : setup->flicker.ToJson();
+    for (const auto& [knob, value] : knobs.items()) {
+      if (!merged.contains(knob)) throw InputError(file, group_field + "." + knob, "unknown knob");
+      if (merged[knob].is_boolean() ? !value.is_boolean() : !value.is_number()) {
+        throw InputError(file, group_field + "." + knob, "wrong type: " + value.dump());
+      }
+      merged[knob] = value;
+    }
+    if (group == "sensor") {
+      SensorParams& s = setup->sensor;
+      s.photons_per_ms = merged["photons_per_ms"];
+      s.quantum_efficiency = merged["quantum_efficiency"];
+      s.full_well_e = merged["full_well_e"];
+      s.system_gain_dn_per_e = merged["system_gain_dn_per_e"];
+      s.dark_noise_e = merged["dark_noise_e"];
+      s.dark_current_e_per_s = merged["dark_current_e_per_s"];
+      s.dsnu_e = merged["dsnu_e"];
+      s.prnu = merged["prnu"];
+      s.bit_depth = merged["bit_depth"].get<int>();
+      s.black_level_dn = merged["black_level_dn"];
+      s.tone_lift = merged["tone_lift"];
+      s.tone_ceiling_drop = merged["tone_ceiling_drop"];
+      s.tone_gamma = merged["tone_gamma"];
+      s.noise = merged["noise"];
+      s.Check(file, group_field + ".");
+    } else {
+      FlickerParams& f = setup->flicker;
+      f.screen_amplitude = merged["screen_amplitude"];
+      f.cut_rate_hz = merged["cut_rate_hz"];
+      f.fade_s = merged["fade_s"];
+      f.flash_rate_hz = merged["flash_rate_hz"];
+      f.flash_gain = merged["flash_gain"];
+      f.flash_s = merged["flash_s"];
+      f.mains_hz = merged["mains_hz"];
+      f.mains_depth = merged["mains_depth"];
+      f.Check(file, group_field + ".");
+    }
+  }
+}
+
+SensorModel::SensorModel(const SensorParams& params,
+                         uint64_t seed,
+                         const std::string& camera,
+                         int width,
+                         int height)
+    : params_(params), stream_(MixHash(seed, StringHash(camera))) {
+  prnu_.create(height, width, CV_32FC1);
+  dsnu_.create(height, width, CV_32FC1);
+  const uint64_t pattern_stream = MixHash(stream_, 0x5EED);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      float a, b;
+      StandardNormalPair(MixHash(pattern_stream, uint64_t(y) * width + x), &a, &b);
+      prnu_.at<float>(y, x) = static_cast<float>(params.prnu * a);
+      dsnu_.at<float>(y, x) = static_cast<float>(params.dsnu_e * b);
+    }
+  }
+  if (params.bit_depth == 8 || !params.LinearTone()) {
+    const int levels = 1 << params.bit_depth;
+    tone_lut_.create(1, levels, CV_8UC1);
+    for (int dn = 0; dn < levels; ++dn) {
+      const double x = double(dn) / (levels - 1);
+      const double y = params.tone_lift +
+                       (1 - params.tone_lift - params.tone_ceiling_drop) * std::pow(x, params.tone_gamma);
+      tone_lut_.at<uint8_t>(0, dn) = cv::saturate_cast<uint8_t>(std::lround(255.0 * y));
+    }
+  }
+}
+
+cv::Mat SensorModel::Expose(const cv::Mat& radiance, double exposure_ms, uint64_t frame_index) const {
+  CV_Assert(radiance.type() == CV_32FC1 && radiance.size() == prnu_.size());
+  const SensorParams& p = params_;
+  const double photons_scale = p.photons_per_ms * exposure_ms;
+  const float signal_scale = static_cast<float>(p.quantum_efficiency * photons_scale);
+  const float dark_mean = static_cast<float>(p.dark_current_e_per_s * exposure_ms / 1000.0);
+  const float read_sigma = static_cast<float>(p.dark_noise_e);
+  const float gain = static_cast<float>(p.system_gain_dn_per_e);
+  const float black = static_cast<float>(p.black_level_dn);
+  const float full_well = static_cast<float>(p.full_well_e);
+  const float max_dn = static_cast<float>((1 << p.bit_depth) - 1);
+  const uint64_t frame_stream = MixHash(stream_, frame_index + 1);
+  cv::Mat dn(radiance.size(), CV_16UC1);
+  cv::parallel_for_(cv::Range(0, radiance.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const float* in = radiance.ptr<float>(y);
+      const float* prnu = prnu_.ptr<float>(y);
+      const float* dsnu = dsnu_.ptr<float>(y);
+      uint16_t* out = dn.ptr<uint16_t>(y);
+      for (int x = 0; x < radiance.cols; ++x) {
+        // Collected charge: signal (with the pixel's gain) and dark current,
+        // with their shot noise (Poisson variance = mean, drawn as a
+        // Gaussian), clipped at the full well.
+        const float signal_e = std::max(0.0f, in[x]) * signal_scale * (1.0f + prnu[x]);
+        float charge = signal_e + dark_mean;
+        float read = 0.0f;
+        if (p.noise) {
+          float z0, z1;
+          StandardNormalPair(MixHash(frame_stream, uint64_t(y) * radiance.cols + x), &z0, &z1);
+          charge += std::sqrt(charge) * z0;
+          read = read_sigma * z1;
+        }
+        charge = std::min(std::max(charge, 0.0f), full_well);
+        // Offsets that are not charge (DSNU, read noise) may be negative; the
+        // black level keeps them inside the ADC range.
+        const float value = std::nearbyint(black + gain * (charge + dsnu[x] + read));
+        out[x] = static_cast<uint16_t>(std::min(std::max(value, 0.0f), max_dn));
+      }
+    }
+  });
+  return dn;
+}
+
+cv::Mat SensorModel::ToOutput(const cv::Mat& raw_dn) const {
+  if (tone_lut_.empty()) return raw_dn.clone();  // linear, > 8 bits: 16-bit PNG of raw DN
+  cv::Mat out(raw_dn.size(), CV_8UC1);
+  const uint8_t* lut = tone_lut_.ptr<uint8_t>(0);
+  for (int y = 0; y < raw_dn.rows; ++y) {
+    const uint16_t* in = raw_dn.ptr<uint16_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < raw_dn.cols; ++x) o[x] = lut[in[x]];
+  }
+  return out;
+}
+
+}  // namespace irbench
