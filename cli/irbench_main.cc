@@ -29,6 +29,14 @@ void AddRenderInputOptions(CLI::App* cmd, irbench::RenderJobOptions& o, std::str
       ->capture_default_str();
   cmd->add_option("--supersample", o.supersample, "pinhole pixels per output pixel per axis (1-4)")
       ->capture_default_str();
+  cmd->add_option("--sensor", o.sensor, "sensor preset: clean, thesis or harsh")->capture_default_str();
+  cmd->add_option_function<std::string>(
+         "--shadows",
+         [&o](const std::string& v) {
+           if (v != "on" && v != "off") throw irbench::InputError("", "--shadows", "must be on or off");
+           o.shadows = v == "on";
+         },
+         "soft shadows of the scene's lights: on or off (default: on unless --sensor clean)");
 }
 
 irbench::GlBackend BackendOrThrow(const std::string& name) {
@@ -62,7 +70,6 @@ int main(int argc, char** argv) {
                          "empty-stage frames per camera")
       ->capture_default_str();
   render_cmd->add_option("--seed", render.seed, "seed for everything random")->capture_default_str();
-  render_cmd->add_option("--sensor", render.sensor, "sensor preset (clean)")->capture_default_str();
   std::string out;
   render_cmd->add_option("--out", out,
                          "output folder (default: renders/<rig>-<avatar>-<motion>-s<seed>)");

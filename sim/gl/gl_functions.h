@@ -66,7 +66,10 @@ namespace irbench {
   X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                   \
   X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                   \
   X(PFNGLDRAWELEMENTSPROC, DrawElements)                               \
-  X(PFNGLFINISHPROC, Finish)
+  X(PFNGLFINISHPROC, Finish)                                           \
+  X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                             \
+  X(PFNGLTEXIMAGE3DPROC, TexImage3D)                                   \
+  X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, FramebufferTextureLayer)
 
 struct GlFunctions {
 #define IRBENCH_GL_MEMBER(type, name) type name = nullptr;

@@ -28,7 +28,7 @@ void main() {
 }
 )";
 
-constexpr const char* kFragmentShader = R"(#version 330 core
+constexpr const char* kFragmentShader = R"(
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_material;
@@ -41,9 +41,66 @@ uniform vec3 u_light_position[8];
 uniform vec3 u_light_direction[8];
 uniform float u_light_cos_half[8];
 uniform float u_light_power[8];
+uniform int u_light_shadow_slot[8];  // -1: no shadow map
+uniform sampler2DArray u_shadow_maps;  // one layer per shadow slot
+uniform mat4 u_shadow_clip_from_world[4];
+uniform mat4 u_shadow_cam_from_world[4];
+uniform float u_shadow_size_uv[4];  // light side / (2 tan(fov / 2))
+uniform float u_shadow_texel[4];    // one texel in uv
 layout(location = 0) out float o_grey;
 layout(location = 1) out float o_mask;
 layout(location = 2) out float o_depth;
+
+#if SHADOWS
+float ShadowDepth(int slot, vec2 uv) { return texture(u_shadow_maps, vec3(uv, float(slot))).r; }
+
+// Percentage-closer soft shadows for a square light: average the blockers'
+// depth over the light's visibility pyramid, then filter over the pyramid's
+// cross-section at that depth, so the penumbra grows as size * (z_r - z_b) / z_b.
+// Depth comparisons follow the receiver's plane (its depth gradient in uv), so
+// wide kernels do not shadow the receiver itself.
+float Visibility(int slot, vec3 p) {
+  vec4 clip = u_shadow_clip_from_world[slot] * vec4(p, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  float z_r = (u_shadow_cam_from_world[slot] * vec4(p, 1.0)).z;
+  vec3 dx = dFdx(vec3(uv, z_r));
+  vec3 dy = dFdy(vec3(uv, z_r));
+  float det = dx.x * dy.y - dx.y * dy.x;
+  vec2 dz_duv = abs(det) > 1e-12
+      ? vec2(dy.y * dx.z - dx.y * dy.z, dx.x * dy.z - dy.x * dx.z) / det
+      : vec2(0.0);
+  dz_duv = clamp(dz_duv, vec2(-50.0 * z_r), vec2(50.0 * z_r));
+  float texel = u_shadow_texel[slot];
+  float bias = 0.01 + 0.004 * z_r;
+  float size = u_shadow_size_uv[slot];
+  float search = max(3.0 * size / z_r, 2.0 * texel);
+  float blockers = 0.0;
+  float depth_sum = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    for (int k = 0; k < 3; ++k) {
+      vec2 o = (vec2(j, k) / 2.0 - 0.5) * search;
+      float d = ShadowDepth(slot, uv + o);
+      if (d < z_r + dot(dz_duv, o) - bias) {
+        depth_sum += d;
+        blockers += 1.0;
+      }
+    }
+  }
+  if (blockers == 0.0) return 1.0;
+  float z_b = depth_sum / blockers;
+  float width = max(size * (z_r - z_b) / (z_r * z_b), texel);
+  float lit = 0.0;
+  for (int j = 0; j < 5; ++j) {
+    for (int k = 0; k < 5; ++k) {
+      vec2 o = ((vec2(j, k) + 0.5) / 5.0 - 0.5) * width;
+      lit += ShadowDepth(slot, uv + o) < z_r + dot(dz_duv, o) - bias ? 0.0 : 1.0;
+    }
+  }
+  return lit / 25.0;
+}
+#endif
+
 void main() {
   vec3 n = normalize(v_normal);
   if (dot(n, u_camera_center - v_world) < 0.0) n = -n;  // two-sided
@@ -58,7 +115,13 @@ void main() {
       vec3 l = to_light * inversesqrt(dot(to_light, to_light));
       float c = dot(-l, u_light_direction[i]);
       float cone = smoothstep(u_light_cos_half[i] - 0.05, u_light_cos_half[i] + 0.05, c);
-      irradiance += u_light_power[i] * cone * max(dot(n, l), 0.0) / d2;
+      float lambert = max(dot(n, l), 0.0);
+      float vis = 1.0;
+      int slot = u_light_shadow_slot[i];
+#if SHADOWS
+      if (slot >= 0 && cone * lambert > 0.0) vis = Visibility(slot, v_world);
+#endif
+      irradiance += u_light_power[i] * cone * lambert * vis / d2;
     }
     radiance = v_material.x * irradiance;
   }
@@ -66,6 +129,25 @@ void main() {
   o_mask = u_person;
   o_depth = v_depth;
 }
+)";
+
+// Shadow maps: camera-frame z of the nearest surface seen from the light.
+constexpr const char* kShadowVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_clip_from_world;
+uniform mat4 u_cam_from_world;
+out float v_z;
+void main() {
+  vec4 p = vec4(a_position, 1.0);
+  gl_Position = u_clip_from_world * p;
+  v_z = (u_cam_from_world * p).z;
+}
+)";
+
+constexpr const char* kShadowFragmentShader = R"(#version 330 core
+in float v_z;
+layout(location = 0) out float o_z;
+void main() { o_z = v_z; }
 )";
 
 unsigned CompileShader(const GlFunctions& gl, GLenum type, const char* source) {
@@ -80,6 +162,25 @@ unsigned CompileShader(const GlFunctions& gl, GLenum type, const char* source) {
     throw RuntimeError(std::string("shader compilation failed: ") + log);
   }
   return shader;
+}
+
+unsigned LinkProgram(const GlFunctions& gl, const char* vertex, const char* fragment) {
+  const unsigned vs = CompileShader(gl, GL_VERTEX_SHADER, vertex);
+  const unsigned fs = CompileShader(gl, GL_FRAGMENT_SHADER, fragment);
+  const unsigned program = gl.CreateProgram();
+  gl.AttachShader(program, vs);
+  gl.AttachShader(program, fs);
+  gl.LinkProgram(program);
+  GLint ok = 0;
+  gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    gl.GetProgramInfoLog(program, sizeof(log), nullptr, log);
+    throw RuntimeError(std::string("shader link failed: ") + log);
+  }
+  gl.DeleteShader(vs);
+  gl.DeleteShader(fs);
+  return program;
 }
 
 // clip_from_cam for an OpenCV camera (x right, y down, z forward) whose pixel
@@ -117,6 +218,11 @@ void RenderOptions::Check() const {
   if (near_m <= 0 || far_m <= near_m) throw InputError("", "near_m", "need 0 < near < far");
 }
 
+struct Renderer::ShadowMap {
+  unsigned fbo = 0, depth_rbo = 0;
+  Eigen::Matrix4f clip_from_world, cam_from_world;
+};
+
 struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
@@ -129,21 +235,12 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
     : context_(context), gl_(context.gl()), cameras_(std::move(cameras)), options_(options) {
   options_.Check();
   const GlFunctions& gl = gl_;
-  const unsigned vs = CompileShader(gl, GL_VERTEX_SHADER, kVertexShader);
-  const unsigned fs = CompileShader(gl, GL_FRAGMENT_SHADER, kFragmentShader);
-  program_ = gl.CreateProgram();
-  gl.AttachShader(program_, vs);
-  gl.AttachShader(program_, fs);
-  gl.LinkProgram(program_);
-  GLint ok = 0;
-  gl.GetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048];
-    gl.GetProgramInfoLog(program_, sizeof(log), nullptr, log);
-    throw RuntimeError(std::string("shader link failed: ") + log);
-  }
-  gl.DeleteShader(vs);
-  gl.DeleteShader(fs);
+  // Without shadows the shadow code is compiled out: llvmpipe would otherwise
+  // pay for its loops on every fragment.
+  const std::string fragment = std::string("#version 330 core\n#define SHADOWS ") +
+                               (options_.shadows ? "1" : "0") + "\n" + kFragmentShader;
+  program_ = LinkProgram(gl, kVertexShader, fragment.c_str());
+  shadow_program_ = LinkProgram(gl, kShadowVertexShader, kShadowFragmentShader);
   gl.UseProgram(program_);
   SetLighting({}, 1.0);
 
@@ -248,9 +345,15 @@ Renderer::~Renderer() {
     gl.DeleteRenderbuffers(1, &t->depth_rbo);
   }
   for (unsigned* b : {&static_vbo_, &static_ibo_, &person_vbo_, &person_ibo_}) gl.DeleteBuffers(1, b);
+  for (auto& m : shadow_maps_) {
+    gl.DeleteFramebuffers(1, &m->fbo);
+    gl.DeleteRenderbuffers(1, &m->depth_rbo);
+  }
+  if (shadow_array_ != 0) gl.DeleteTextures(1, &shadow_array_);
   gl.DeleteVertexArrays(1, &static_vao_);
   gl.DeleteVertexArrays(1, &person_vao_);
   gl.DeleteProgram(program_);
+  gl.DeleteProgram(shadow_program_);
 }
 
 const Camera& Renderer::RenderCamera(int index) const { return targets_.at(index)->render_camera; }
@@ -270,6 +373,7 @@ void Renderer::SetStaticMesh(const TriangleMesh& mesh) {
                 GL_STATIC_DRAW);
   static_index_count_ = static_cast<int>(mesh.indices.size());
   gl.BindVertexArray(0);
+  shadows_dirty_ = true;
 }
 
 void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
@@ -279,18 +383,126 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   gl.Uniform1f(gl.GetUniformLocation(program_, "u_ambient"), static_cast<float>(ambient));
   gl.Uniform1i(gl.GetUniformLocation(program_, "u_light_count"), n);
   std::vector<float> pos(24, 0), dir(24, 0), cos_half(8, 1), power(8, 0);
-  for (int i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      pos[3 * i + k] = static_cast<float>(lights[i].position[k]);
-      dir[3 * i + k] = static_cast<float>(lights[i].direction[k]);
-    }
-    cos_half[i] = static_cast<float>(std::cos(lights[i].cone_deg * M_PI / 360.0));
-    power[i] = static_cast<float>(lights[i].power);
+  std::vector<int> slot(8, -1);
+  std::vector<float> size_uv(4, 0), texel(4, 1);
+  std::vector<Eigen::Matrix4f> shadow_clip(4, Eigen::Matrix4f::Identity()),
+      shadow_cam(4, Eigen::Matrix4f::Identity());
+  for (auto& m : shadow_maps_) {
+    gl.DeleteFramebuffers(1, &m->fbo);
+    gl.DeleteRenderbuffers(1, &m->depth_rbo);
   }
+  shadow_maps_.clear();
+  if (options_.shadows && shadow_array_ == 0) {
+    // Four layers of camera-frame z, one per shadowing light.
+    gl.GenTextures(1, &shadow_array_);
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, shadow_array_);
+    gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, options_.shadow_map_size, options_.shadow_map_size, 4,
+                  0, GL_RED, GL_FLOAT, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  for (int i = 0; i < n; ++i) {
+    const IrLight& light = lights[i];
+    for (int k = 0; k < 3; ++k) {
+      pos[3 * i + k] = static_cast<float>(light.position[k]);
+      dir[3 * i + k] = static_cast<float>(light.direction[k]);
+    }
+    cos_half[i] = static_cast<float>(std::cos(light.cone_deg * M_PI / 360.0));
+    power[i] = static_cast<float>(light.power);
+    if (!options_.shadows || !light.casts_shadows || shadow_maps_.size() >= 4) continue;
+    // A pinhole "camera" at the light covering its cone.
+    const double fov = std::min(light.cone_deg + 10.0, 150.0) * M_PI / 180.0;
+    const int size = options_.shadow_map_size;
+    Camera view;
+    view.width = view.height = size;
+    view.fx = view.fy = 0.5 * size / std::tan(fov / 2);
+    view.cx = view.cy = 0.5 * (size - 1);
+    const Eigen::Vector3d up =
+        std::abs(light.direction.z()) > 0.9 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+    view.cam_from_world = *LookAt(light.position, light.position + light.direction, up);
+    auto map = std::make_unique<ShadowMap>();
+    map->cam_from_world = view.cam_from_world.matrix().cast<float>();
+    map->clip_from_world = ClipFromCam(view, options_.near_m, options_.far_m) * map->cam_from_world;
+    gl.GenFramebuffers(1, &map->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, map->fbo);
+    gl.FramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_array_, 0,
+                               static_cast<GLint>(shadow_maps_.size()));
+    gl.GenRenderbuffers(1, &map->depth_rbo);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, map->depth_rbo);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size, size);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, map->depth_rbo);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
+    gl.DrawBuffers(1, buffers);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw RuntimeError("shadow framebuffer incomplete");
+    }
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    const int s = static_cast<int>(shadow_maps_.size());
+    slot[i] = s;
+    size_uv[s] = static_cast<float>(light.size_m / (2 * std::tan(fov / 2)));
+    texel[s] = 1.0f / size;
+    shadow_clip[s] = map->clip_from_world;
+    shadow_cam[s] = map->cam_from_world;
+    shadow_maps_.push_back(std::move(map));
+  }
+  gl.UseProgram(program_);
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_light_position"), 8, pos.data());
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_light_direction"), 8, dir.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_light_cos_half"), 8, cos_half.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_light_power"), 8, power.data());
+  for (int i = 0; i < 8; ++i) {
+    gl.Uniform1i(gl.GetUniformLocation(program_, ("u_light_shadow_slot[" + std::to_string(i) + "]").c_str()),
+                 slot[i]);
+  }
+  for (int k = 0; k < 4; ++k) {
+    const std::string index = "[" + std::to_string(k) + "]";
+    gl.UniformMatrix4fv(gl.GetUniformLocation(program_, ("u_shadow_clip_from_world" + index).c_str()), 1,
+                        GL_FALSE, shadow_clip[k].data());
+    gl.UniformMatrix4fv(gl.GetUniformLocation(program_, ("u_shadow_cam_from_world" + index).c_str()), 1,
+                        GL_FALSE, shadow_cam[k].data());
+  }
+  gl.Uniform1i(gl.GetUniformLocation(program_, "u_shadow_maps"), 1);
+  gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_size_uv"), 4, size_uv.data());
+  gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_texel"), 4, texel.data());
+  shadows_dirty_ = true;
+}
+
+void Renderer::DrawGeometry() {
+  const GlFunctions& gl = gl_;
+  if (person_visible_ && person_index_count_ > 0) {
+    gl.BindVertexArray(person_vao_);
+    gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
+  }
+  if (static_index_count_ > 0) {
+    gl.BindVertexArray(static_vao_);
+    gl.DrawElements(GL_TRIANGLES, static_index_count_, GL_UNSIGNED_INT, nullptr);
+  }
+  gl.BindVertexArray(0);
+}
+
+void Renderer::UpdateShadows() {
+  if (shadow_maps_.empty() || !shadows_dirty_) return;
+  const GlFunctions& gl = gl_;
+  gl.UseProgram(shadow_program_);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  const float far_value[4] = {1e9f, 0, 0, 0};
+  const float one = 1.0f;
+  for (const auto& map : shadow_maps_) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, map->fbo);
+    gl.Viewport(0, 0, options_.shadow_map_size, options_.shadow_map_size);
+    gl.ClearBufferfv(GL_COLOR, 0, far_value);
+    gl.ClearBufferfv(GL_DEPTH, 0, &one);
+    gl.UniformMatrix4fv(gl.GetUniformLocation(shadow_program_, "u_clip_from_world"), 1, GL_FALSE,
+                        map->clip_from_world.data());
+    gl.UniformMatrix4fv(gl.GetUniformLocation(shadow_program_, "u_cam_from_world"), 1, GL_FALSE,
+                        map->cam_from_world.data());
+    DrawGeometry();
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  shadows_dirty_ = false;
 }
 
 void Renderer::SetPersonTopology(const std::vector<uint32_t>& indices, size_t vertex_count) {
@@ -312,9 +524,11 @@ void Renderer::UpdatePerson(const std::vector<MeshVertex>& vertices) {
   const GlFunctions& gl = gl_;
   gl.BindBuffer(GL_ARRAY_BUFFER, person_vbo_);
   gl.BufferSubData(GL_ARRAY_BUFFER, 0, vertices.size() * sizeof(MeshVertex), vertices.data());
+  shadows_dirty_ = true;
 }
 
 void Renderer::Render(int index, CameraImages* out, bool want_depth) {
+  UpdateShadows();
   Draw(index);
   Read(index, out, want_depth);
 }
@@ -324,6 +538,7 @@ void Renderer::RenderAll(std::vector<CameraImages>* out, bool want_depth) {
   // on its worker threads once the next framebuffer is bound, so the read-back
   // and resampling of one camera overlap the rasterisation of the others.
   out->resize(targets_.size());
+  UpdateShadows();
   for (size_t i = 0; i < targets_.size(); ++i) Draw(static_cast<int>(i));
   for (size_t i = 0; i < targets_.size(); ++i) Read(static_cast<int>(i), &(*out)[i], want_depth);
 }
@@ -348,6 +563,11 @@ void Renderer::Draw(int index) {
                       cam_from_world.data());
   const Eigen::Vector3f center = rc.CenterInWorld().cast<float>();
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_camera_center"), 1, center.data());
+  if (shadow_array_ != 0) {
+    gl.ActiveTexture(GL_TEXTURE1);
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, shadow_array_);
+    gl.ActiveTexture(GL_TEXTURE0);
+  }
   const GLint person_loc = gl.GetUniformLocation(program_, "u_person");
   // Near to far: the person, then the scene (rooms last), for early depth rejection.
   if (person_visible_ && person_index_count_ > 0) {

@@ -21,6 +21,10 @@ struct RenderOptions {
   int supersample = 2;   // pinhole pixels per output pixel, per axis
   double near_m = 0.05;  // clip planes
   double far_m = 80.0;
+  // Soft shadows of the scene's lights (up to 4 lights with `casts_shadows`),
+  // penumbrae from each light's size (percentage-closer soft shadows).
+  bool shadows = false;
+  int shadow_map_size = 1024;
 
   // Throws InputError for bad values.
   void Check() const;
@@ -50,7 +54,10 @@ class Renderer {
   // Person mesh: topology once, vertices once per frame.
   void SetPersonTopology(const std::vector<uint32_t>& indices, size_t vertex_count);
   void UpdatePerson(const std::vector<MeshVertex>& vertices);
-  void SetPersonVisible(bool visible) { person_visible_ = visible; }
+  void SetPersonVisible(bool visible) {
+    shadows_dirty_ = shadows_dirty_ || visible != person_visible_;
+    person_visible_ = visible;
+  }
 
   // Renders camera `index`; `out->depth` is filled only when `want_depth`.
   void Render(int index, CameraImages* out, bool want_depth);
@@ -73,6 +80,9 @@ class Renderer {
 
  private:
   struct Target;
+  struct ShadowMap;
+  void UpdateShadows();
+  void DrawGeometry();
   void Draw(int index);
   void Read(int index, CameraImages* out, bool want_depth);
   GlContext& context_;
@@ -81,6 +91,10 @@ class Renderer {
   RenderOptions options_;
   std::vector<std::unique_ptr<Target>> targets_;
   unsigned program_ = 0;
+  unsigned shadow_program_ = 0;
+  std::vector<std::unique_ptr<ShadowMap>> shadow_maps_;
+  unsigned shadow_array_ = 0;  // GL_TEXTURE_2D_ARRAY, a layer per shadow map
+  bool shadows_dirty_ = true;
   unsigned static_vao_ = 0, static_vbo_ = 0, static_ibo_ = 0;
   int static_index_count_ = 0;
   unsigned person_vao_ = 0, person_vbo_ = 0, person_ibo_ = 0;

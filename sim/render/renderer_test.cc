@@ -148,3 +148,84 @@ INSTANTIATE_TEST_SUITE_P(Backends, RendererTest,
 
 }  // namespace
 }  // namespace irbench
+
+namespace irbench {
+namespace {
+
+// Penumbra of a plate's straight edge on the floor under a square light of
+// side S straight above: geometry predicts a linear ramp of width
+// S * (z_r - z_b) / z_b along the floor (z_b, z_r: the plate's and the
+// floor's distances from the light). Measured between 10% and 90% of the
+// lit level, divided by 0.8; the lit level comes from the same render without
+// the plate.
+double MeasurePenumbra(GlContext& context, double light_size, double* predicted) {
+  Camera cam;
+  cam.width = 640;
+  cam.height = 480;
+  cam.fx = cam.fy = 600;
+  cam.cx = 319.5;
+  cam.cy = 239.5;
+  cam.cam_from_world = *LookAt({1.2, 0.0, 2.6}, {0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
+  RenderOptions options;
+  options.shadows = true;
+  options.shadow_map_size = 2048;
+  Renderer renderer(context, {cam}, options);
+  IrLight light;
+  light.position = {0, 0, 3.0};
+  light.direction = {0, 0, -1};
+  light.cone_deg = 100;
+  light.power = 8.0;
+  light.size_m = light_size;
+  renderer.SetLighting({light}, 0.0);
+  const double plate_top = 1.02;
+  auto render = [&](bool with_plate) {
+    TriangleMesh mesh;
+    AppendQuad(mesh, {-3, -3, 0}, {6, 0, 0}, {0, 6, 0}, Material{0.8f, 0.0f});
+    if (with_plate) AppendBox(mesh, {-2.5, -2.5, 1.0}, {0.0, 2.5, plate_top}, Material{0.5f, 0.0f}, false);
+    renderer.SetStaticMesh(mesh);
+    CameraImages images;
+    renderer.Render(0, &images, false);
+    return images.grey;
+  };
+  const cv::Mat shadowed = render(true), lit = render(false);
+  // Visibility along the floor line y = 0, x in [-0.6, 0.6].
+  std::vector<std::pair<double, double>> profile;
+  for (double x = -0.6; x <= 0.6; x += 0.002) {
+    const Eigen::Vector2d px = cam.Project({x, 0, 0});
+    cv::Mat patch_s, patch_l;
+    cv::getRectSubPix(shadowed, {1, 1}, cv::Point2f(px.x(), px.y()), patch_s, CV_32F);
+    cv::getRectSubPix(lit, {1, 1}, cv::Point2f(px.x(), px.y()), patch_l, CV_32F);
+    profile.emplace_back(x, patch_s.at<float>(0, 0) / std::max(1.0f, patch_l.at<float>(0, 0)));
+  }
+  auto crossing = [&](double level) {
+    for (size_t i = 1; i < profile.size(); ++i) {
+      if (profile[i - 1].second < level && profile[i].second >= level) {
+        const double u = (level - profile[i - 1].second) / (profile[i].second - profile[i - 1].second);
+        return profile[i - 1].first + u * (profile[i].first - profile[i - 1].first);
+      }
+    }
+    return std::nan("");
+  };
+  const double z_b = 3.0 - plate_top, z_r = 3.0;
+  *predicted = light_size * (z_r - z_b) / z_b;
+  EXPECT_LT(profile.front().second, 0.05) << "the plate's shadow is dark";
+  EXPECT_GT(profile.back().second, 0.95) << "beyond the penumbra the floor is lit";
+  return (crossing(0.9) - crossing(0.1)) / 0.8;
+}
+
+TEST(ShadowTest, PenumbraWidthFollowsTheLightSize) {
+  auto context = CreateGlContext(GlBackend::kAuto);
+  double predicted = 0;
+  for (double size : {0.3, 0.6}) {
+    const double measured = MeasurePenumbra(*context, size, &predicted);
+    EXPECT_NEAR(measured, predicted, 0.2 * predicted) << "light size " << size;
+    std::printf("area light %.2f m: penumbra %.3f m, predicted %.3f m\n", size, measured, predicted);
+  }
+  // A point source: a hard edge, as sharp as the shadow map and pixels allow.
+  const double point = MeasurePenumbra(*context, 0.0, &predicted);
+  EXPECT_LT(point, 0.02);
+  std::printf("point light: penumbra %.4f m (predicted 0)\n", point);
+}
+
+}  // namespace
+}  // namespace irbench

@@ -147,7 +147,8 @@ Scene LoadScene(const std::filesystem::path& path) {
     if (lights.Size() > 8) lights.Fail("at most 8 lights");
     for (size_t i = 0; i < lights.Size(); ++i) {
       const JsonNode l = lights[i];
-      l.CheckKeys({"name", "position", "look_at", "cone_deg", "power", "wavelength_nm"});
+      l.CheckKeys({"name", "position", "look_at", "cone_deg", "power", "wavelength_nm", "size_m",
+                   "shadows"});
       IrLight light;
       light.name = l.GetString("name");
       light.position = l.GetVec3("position");
@@ -162,6 +163,9 @@ Scene LoadScene(const std::filesystem::path& path) {
       if (light.wavelength_nm != 850.0 && light.wavelength_nm != 940.0) {
         l["wavelength_nm"].Fail("must be 850 or 940");
       }
+      light.size_m = l.GetDouble("size_m", 0.0);
+      if (light.size_m < 0 || light.size_m > 5) l["size_m"].Fail("must be in [0, 5] m");
+      light.casts_shadows = l.GetBool("shadows", true);
       scene.lights.push_back(light);
     }
   }

@@ -20,6 +20,10 @@ struct IrLight {
   double cone_deg = 60.0;  // full opening angle
   double power = 1.0;      // relative radiant intensity on axis
   double wavelength_nm = 850.0;
+  // Side of the square emitting area facing `direction`, metres; 0 is a point.
+  // Shadows' penumbrae grow with it (rendered when shadows are on).
+  double size_m = 0.0;
+  bool casts_shadows = true;
 };
 
 struct Scene {

@@ -23,6 +23,7 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
     in.rig.cameras = cameras;
     RenderOptions render_options;
     render_options.supersample = options.supersample;
+    render_options.shadows = options.shadows.value_or(options.sensor != "clean");
     Renderer renderer(*context, cameras, render_options);
     renderer.SetScene(in.scene);
     renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());

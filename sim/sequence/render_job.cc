@@ -143,6 +143,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   Log().info("render: {} backend, {}", context->BackendName(), context->RendererString());
   RenderOptions render_options;
   render_options.supersample = options.supersample;
+  render_options.shadows = options.shadows.value_or(options.sensor != "clean");
   Renderer renderer(*context, in.rig.cameras, render_options);
   renderer.SetScene(in.scene);
   renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
@@ -190,7 +191,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["depth"] = options.write_depth;
   manifest["renderer"] = {{"backend", context->BackendName()},
                           {"gl", context->RendererString()},
-                          {"supersample", options.supersample}};
+                          {"supersample", options.supersample},
+                          {"shadows", render_options.shadows}};
   manifest["files"] = {{"frames", "frames/<cam>/NNNNNN.png"},
                        {"background", "background/<cam>/NNNNNN.png"},
                        {"masks", "truth/masks/<cam>/NNNNNN.png"},

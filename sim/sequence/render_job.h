@@ -32,6 +32,9 @@ struct RenderJobOptions {
   bool write_depth = false;
   GlBackend backend = GlBackend::kAuto;
   int supersample = 2;
+  // Soft shadows of the scene's lights; default: on with a sensor preset other
+  // than clean.
+  std::optional<bool> shadows;
 };
 
 // Everything a render needs, loaded and validated (InputError on bad input).
