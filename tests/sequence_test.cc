@@ -211,6 +211,50 @@ TEST(SensorSequenceTest, SeedDecidesTheNoise) {
   EXPECT_TRUE(truth["sensor"]["side"].contains("flicker"));
 }
 
+// Per-camera knobs from the rig: a camera that drops frames repeats its last
+// image and says so in the truth; motion blur changes the frames but not the
+// masks or the truth.
+TEST(SensorSequenceTest, DroppedFramesAndMotionBlurFromRigOverrides) {
+  const fs::path dir = FreshTempDir("seq_capture");
+  auto rig = nlohmann::json::parse(ReadText(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json"));
+  rig["cameras"][0]["sensor"] = {{"capture", {{"drop_rate", 0.5}}}};
+  rig["cameras"][1]["sensor"] = {{"optics", {{"motion_blur_samples", 3}}}};
+  WriteText(dir / "rig.json", rig.dump());
+  WriteText(dir / "fast.json", irbench::testing::FastMotionJson());
+  RenderJobOptions options;
+  options.rig = (dir / "rig.json").string();
+  options.motion = (dir / "fast.json").string();
+  options.frames = 7;
+  options.background_frames = 0;
+  options.sensor = "thesis";
+  options.out = dir / "seq";
+  const fs::path seq = RunRenderJob(options);
+  std::ifstream truth(seq / "truth/frames.jsonl");
+  std::string line;
+  int dropped = 0;
+  while (std::getline(truth, line)) {
+    const auto frame = nlohmann::json::parse(line);
+    const int f = frame["frame"];
+    EXPECT_FALSE(bool(frame["sensor"]["side"]["dropped"]));
+    if (!bool(frame["sensor"]["front_left"]["dropped"])) continue;
+    ++dropped;
+    char now[16], before[16];
+    std::snprintf(now, sizeof(now), "%06d.png", f);
+    std::snprintf(before, sizeof(before), "%06d.png", f - 1);
+    EXPECT_EQ(ReadText(seq / "frames/front_left" / now), ReadText(seq / "frames/front_left" / before));
+  }
+  EXPECT_GT(dropped, 0);
+  EXPECT_LT(dropped, 7);
+  // The same render without motion blur: other frames of front_right, same masks.
+  rig["cameras"][1]["sensor"] = nullptr;
+  WriteText(dir / "rig.json", rig.dump());
+  options.out = dir / "sharp";
+  const fs::path sharp = RunRenderJob(options);
+  EXPECT_NE(ReadText(seq / "frames/front_right/000003.png"), ReadText(sharp / "frames/front_right/000003.png"));
+  EXPECT_EQ(ReadText(seq / "truth/masks/front_right/000003.png"),
+            ReadText(sharp / "truth/masks/front_right/000003.png"));
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, DeterminismTest,
                          ::testing::Values(GlBackend::kEgl, GlBackend::kOsMesa),
                          [](const auto& info) { return GlBackendName(info.param); });

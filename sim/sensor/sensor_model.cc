@@ -94,6 +94,17 @@ nlohmann::json FlickerParams::ToJson() const {
           {"mains_hz", mains_hz},                 {"mains_depth", mains_depth}};
 }
 
+nlohmann::json OpticsToJson(const OpticsParams& o) {
+  return {{"f_number", o.f_number},
+          {"focal_length_mm", o.focal_length_mm},
+          {"focus_distance_m", o.focus_distance_m},
+          {"vignetting", o.vignetting},
+          {"glare_gain", o.glare_gain},
+          {"glare_threshold", o.glare_threshold},
+          {"glare_sigma_px", o.glare_sigma_px},
+          {"motion_blur_samples", o.motion_blur_samples}};
+}
+
 std::optional<SensorSetup> SensorPreset(const std::string& name) {
   SensorSetup s;
   s.preset = name;
@@ -120,6 +131,13 @@ std::optional<SensorSetup> SensorPreset(const std::string& name) {
     s.flicker.cut_rate_hz = 0.5;
     s.flicker.flash_rate_hz = 0.1;
     s.flicker.mains_depth = 0.05;
+    // Thesis Fig. 1.3: "the image is blurry": a wide aperture in the dark.
+    s.optics.f_number = 1.4;
+    s.optics.focus_distance_m = 3.8;
+    s.optics.vignetting = 0.5;
+    s.optics.glare_gain = 0.3;
+    // At 8 ms a hand at 2 m/s moves about one pixel: no sub-frames needed.
+    s.optics.motion_blur_samples = 1;
     return s;
   }
   if (name == "harsh") {
@@ -136,6 +154,12 @@ std::optional<SensorSetup> SensorPreset(const std::string& name) {
     s.flicker.cut_rate_hz = 1.5;
     s.flicker.flash_rate_hz = 0.4;
     s.flicker.mains_depth = 0.15;
+    s.optics.f_number = 1.0;
+    s.optics.focus_distance_m = 3.0;
+    s.optics.vignetting = 0.8;
+    s.optics.glare_gain = 0.6;
+    s.optics.motion_blur_samples = 4;
+    s.capture.drop_rate = 0.01;
     return s;
   }
   return std::nullopt;
@@ -148,12 +172,14 @@ void ApplySensorOverrides(const nlohmann::json& overrides,
   if (!overrides.is_object()) throw InputError(file, prefix, "expected an object");
   for (const auto& [group, knobs] : overrides.items()) {
     const std::string group_field = prefix + "." + group;
-    if (group != "sensor" && group != "flicker") {
-      throw InputError(file, group_field, "unknown group (sensor, flicker)");
+    if (group != "sensor" && group != "flicker" && group != "optics" && group != "capture") {
+      throw InputError(file, group_field, "unknown group (sensor, flicker, optics, capture)");
     }
     if (!knobs.is_object()) throw InputError(file, group_field, "expected an object");
-    nlohmann::json merged =
-        group == "sensor" ? setup->sensor.ToJson() : setup->flicker.ToJson();
+    nlohmann::json merged = group == "sensor"    ? setup->sensor.ToJson()
+                            : group == "flicker" ? setup->flicker.ToJson()
+                            : group == "optics"  ? OpticsToJson(setup->optics)
+                                                 : nlohmann::json{{"drop_rate", setup->capture.drop_rate}};
     for (const auto& [knob, value] : knobs.items()) {
       if (!merged.contains(knob)) throw InputError(file, group_field + "." + knob, "unknown knob");
       if (merged[knob].is_boolean() ? !value.is_boolean() : !value.is_number()) {
@@ -178,6 +204,27 @@ void ApplySensorOverrides(const nlohmann::json& overrides,
       s.tone_gamma = merged["tone_gamma"];
       s.noise = merged["noise"];
       s.Check(file, group_field + ".");
+    } else if (group == "optics") {
+      OpticsParams& o = setup->optics;
+      o.f_number = merged["f_number"];
+      o.focal_length_mm = merged["focal_length_mm"];
+      o.focus_distance_m = merged["focus_distance_m"];
+      o.vignetting = merged["vignetting"];
+      o.glare_gain = merged["glare_gain"];
+      o.glare_threshold = merged["glare_threshold"];
+      o.glare_sigma_px = merged["glare_sigma_px"];
+      o.motion_blur_samples = static_cast<int>(merged["motion_blur_samples"].get<double>());
+      CheckRange(o.f_number, 0, 64, file, group_field + ".f_number");
+      CheckRange(o.focal_length_mm, 0.5, 500, file, group_field + ".focal_length_mm");
+      CheckRange(o.focus_distance_m, 0.1, 1000, file, group_field + ".focus_distance_m");
+      CheckRange(o.vignetting, 0, 1, file, group_field + ".vignetting");
+      CheckRange(o.glare_gain, 0, 10, file, group_field + ".glare_gain");
+      CheckRange(o.glare_threshold, 0, 10, file, group_field + ".glare_threshold");
+      CheckRange(o.glare_sigma_px, 0.5, 100, file, group_field + ".glare_sigma_px");
+      CheckRange(o.motion_blur_samples, 1, 16, file, group_field + ".motion_blur_samples");
+    } else if (group == "capture") {
+      setup->capture.drop_rate = merged["drop_rate"];
+      CheckRange(setup->capture.drop_rate, 0, 0.5, file, group_field + ".drop_rate");
     } else {
       FlickerParams& f = setup->flicker;
       f.screen_amplitude = merged["screen_amplitude"];

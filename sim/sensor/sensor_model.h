@@ -11,6 +11,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "sim/sensor/optics.h"
+
 namespace irbench {
 
 struct SensorParams {
@@ -57,11 +59,20 @@ struct FlickerParams {
   nlohmann::json ToJson() const;
 };
 
+// Capture faults, recorded in the truth.
+struct CaptureParams {
+  double drop_rate = 0.0;  // probability that a camera drops a frame (it repeats the last one)
+};
+
 struct SensorSetup {
   std::string preset = "clean";
   SensorParams sensor;
   FlickerParams flicker;
+  OpticsParams optics;
+  CaptureParams capture;
 };
+
+nlohmann::json OpticsToJson(const OpticsParams& optics);
 
 // "clean" (no noise, no flicker, linear), "thesis" (the thesis's 1.2: dark,
 // flickering, washed out, grainy), "harsh". nullopt for unknown names.

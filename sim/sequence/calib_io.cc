@@ -73,7 +73,9 @@ nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::vector
     c["exposure_ms"] = cam.exposure_ms;
     c["sensor"] = {{"preset", sensors[i].preset},
                    {"emva1288", sensors[i].sensor.ToJson()},
-                   {"flicker", sensors[i].flicker.ToJson()}};
+                   {"flicker", sensors[i].flicker.ToJson()},
+                   {"optics", OpticsToJson(sensors[i].optics)},
+                   {"capture", {{"drop_rate", sensors[i].capture.drop_rate}}}};
     j["cameras"].push_back(c);
   }
   return j;

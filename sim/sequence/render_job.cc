@@ -217,26 +217,52 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   const double background_s = options.background_frames / in.fps;
   std::vector<SensorModel> sensors;
   std::vector<FlickerModel> flickers;
+  std::vector<Optics> optics;
+  int blur_samples = 1;           // sub-frame renders per frame (motion blur)
+  double blur_exposure_s = 0.0;   // the exposure they span
+  bool need_depth = options.write_depth;
   for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
     const Camera& cam = in.rig.cameras[c];
-    sensors.emplace_back(in.sensors[c].sensor, options.seed, cam.name, cam.width, cam.height);
-    flickers.emplace_back(in.sensors[c].flicker, options.seed, -background_s,
-                          in.frame_count / in.fps);
+    const SensorSetup& setup = in.sensors[c];
+    sensors.emplace_back(setup.sensor, options.seed, cam.name, cam.width, cam.height);
+    flickers.emplace_back(setup.flicker, options.seed, -background_s, in.frame_count / in.fps);
+    optics.emplace_back(setup.optics, cam);
+    if (!in.sensor_active[c]) continue;
+    if (setup.optics.motion_blur_samples > blur_samples) blur_samples = setup.optics.motion_blur_samples;
+    if (setup.optics.motion_blur_samples > 1) {
+      blur_exposure_s = std::max(blur_exposure_s, cam.exposure_ms / 1000.0);
+    }
+    need_depth = need_depth || setup.optics.f_number > 0;
   }
-  // Turns the clean render of camera c into the written frame; records the
-  // frame's illumination level and exposure in `sensor_truth`.
+  // Turns camera c's clean render (or its mean over the exposure's
+  // sub-frames, `radiance_sum` / `samples`) into the written frame; records
+  // the illumination level, exposure and drops in `sensor_truth`.
+  std::vector<cv::Mat> last_written(in.rig.cameras.size());
   cv::Mat radiance;
-  auto expose = [&](size_t c, const cv::Mat& grey, double t, uint64_t noise_frame,
+  auto expose = [&](size_t c, const cv::Mat& grey, const cv::Mat& radiance_sum, int samples,
+                    const cv::Mat& depth, double t, uint64_t noise_frame,
                     nlohmann::json& sensor_truth) -> cv::Mat {
     const Camera& cam = in.rig.cameras[c];
     if (!in.sensor_active[c]) {
-      sensor_truth[cam.name] = {{"flicker", 1.0}, {"exposure_ms", cam.exposure_ms}};
+      sensor_truth[cam.name] = {{"flicker", 1.0}, {"exposure_ms", cam.exposure_ms}, {"dropped", false}};
       return grey;
     }
-    const double level = flickers[c].Level(t, cam.exposure_ms / 1000.0);
-    sensor_truth[cam.name] = {{"flicker", level}, {"exposure_ms", cam.exposure_ms}};
-    grey.convertTo(radiance, CV_32F, level / 255.0);
-    return sensors[c].ToOutput(sensors[c].Expose(radiance, cam.exposure_ms, noise_frame));
+    // The exposure is centred on the frame time, where the truth is.
+    const double exposure_s = cam.exposure_ms / 1000.0;
+    const double level = flickers[c].Level(t - 0.5 * exposure_s, exposure_s);
+    const double drop_u =
+        double(MixHash(MixHash(options.seed, 0xD50Bull + c), noise_frame) >> 11) / 9007199254740992.0;
+    const bool dropped = drop_u < in.sensors[c].capture.drop_rate && !last_written[c].empty();
+    sensor_truth[cam.name] = {{"flicker", level}, {"exposure_ms", cam.exposure_ms}, {"dropped", dropped}};
+    if (dropped) return last_written[c];
+    if (samples > 1) {
+      radiance = radiance_sum * (level / (255.0 * samples));
+    } else {
+      grey.convertTo(radiance, CV_32F, level / 255.0);
+    }
+    const cv::Mat seen = optics[c].Apply(radiance, depth);
+    last_written[c] = sensors[c].ToOutput(sensors[c].Expose(seen, cam.exposure_ms, noise_frame));
+    return last_written[c];
   };
 
   // 4. Empty-stage frames.
@@ -245,32 +271,61 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   renderer.SetPersonVisible(false);
   for (int f = 0; f < options.background_frames; ++f) {
     ThrowIfCancelled();
-    renderer.RenderAll(&all_images, false);
+    renderer.RenderAll(&all_images, need_depth);
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const cv::Mat frame = expose(c, all_images[c].grey, t, (1ull << 40) + f, sensor_truth);
+      const cv::Mat frame = expose(c, all_images[c].grey, cv::Mat(), 1, all_images[c].depth, t,
+                                   (1ull << 40) + f, sensor_truth);
       WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }
     background_lines += nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";
     ++done;
     report("background", f, options.background_frames);
   }
+  for (cv::Mat& m : last_written) m.release();
 
-  // 5. The sequence.
+  // 5. The sequence. With motion blur, sub-frames over the exposure are
+  // rendered and averaged; the last render is always at the frame time, so
+  // masks, depth and visibility belong to the truth's instant.
   renderer.SetPersonVisible(true);
   std::vector<MeshVertex> skinned;
   std::string truth_lines;
   const auto& joint_names = TruthJointNames();
+  std::vector<cv::Mat> radiance_sums(in.rig.cameras.size());
   for (int f = 0; f < in.frame_count; ++f) {
     ThrowIfCancelled();
     const double t = f / in.fps;
+    if (blur_samples > 1) {
+      for (cv::Mat& sum : radiance_sums) sum.release();
+      for (int k = 0; k < blur_samples; ++k) {
+        const double offset = ((k + 0.5) / blur_samples - 0.5) * blur_exposure_s;
+        if (std::abs(offset) < 1e-12) continue;  // the centre sample is the final render
+        PoseAndUpload(in, t + offset, renderer, skinned);
+        renderer.RenderAll(&all_images, false);
+        for (size_t c = 0; c < all_images.size(); ++c) {
+          cv::Mat g;
+          all_images[c].grey.convertTo(g, CV_32F);
+          if (radiance_sums[c].empty()) radiance_sums[c] = g; else radiance_sums[c] += g;
+        }
+      }
+    }
     const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);
-    renderer.RenderAll(&all_images, options.write_depth);
+    renderer.RenderAll(&all_images, need_depth);
+    // With an odd count the centre sub-frame is this render.
+    const int samples = blur_samples;
+    if (blur_samples > 1 && blur_samples % 2 == 1) {
+      for (size_t c = 0; c < all_images.size(); ++c) {
+        cv::Mat g;
+        all_images[c].grey.convertTo(g, CV_32F);
+        radiance_sums[c] += g;
+      }
+    }
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const std::string& cam_name = in.rig.cameras[c].name;
-      const cv::Mat frame = expose(c, all_images[c].grey, t, f, sensor_truth);
+      const cv::Mat frame = expose(c, all_images[c].grey, radiance_sums[c], samples, all_images[c].depth,
+                                   t, f, sensor_truth);
       WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
       WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);
       if (options.write_depth) {
