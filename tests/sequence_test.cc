@@ -219,6 +219,7 @@ TEST(SensorSequenceTest, DroppedFramesAndMotionBlurFromRigOverrides) {
   auto rig = nlohmann::json::parse(ReadText(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json"));
   rig["cameras"][0]["sensor"] = {{"capture", {{"drop_rate", 0.5}}}};
   rig["cameras"][1]["sensor"] = {{"optics", {{"motion_blur_samples", 3}}}};
+  rig["cameras"][2]["sensor"] = {{"capture", {{"sync_jitter_ms", 20.0}}}};
   WriteText(dir / "rig.json", rig.dump());
   WriteText(dir / "fast.json", irbench::testing::FastMotionJson());
   RenderJobOptions options;
@@ -232,10 +233,13 @@ TEST(SensorSequenceTest, DroppedFramesAndMotionBlurFromRigOverrides) {
   std::ifstream truth(seq / "truth/frames.jsonl");
   std::string line;
   int dropped = 0;
+  double jitter_sum = 0;
   while (std::getline(truth, line)) {
     const auto frame = nlohmann::json::parse(line);
     const int f = frame["frame"];
     EXPECT_FALSE(bool(frame["sensor"]["side"]["dropped"]));
+    EXPECT_EQ(double(frame["sensor"]["side"]["sync_offset_ms"]), 0.0);
+    jitter_sum += std::abs(double(frame["sensor"]["overhead"]["sync_offset_ms"]));
     if (!bool(frame["sensor"]["front_left"]["dropped"])) continue;
     ++dropped;
     char now[16], before[16];
@@ -245,14 +249,20 @@ TEST(SensorSequenceTest, DroppedFramesAndMotionBlurFromRigOverrides) {
   }
   EXPECT_GT(dropped, 0);
   EXPECT_LT(dropped, 7);
+  // A 20 ms jitter: offsets of several ms on average (E|N(0, 20)| = 16 ms).
+  EXPECT_GT(jitter_sum / 7, 5.0);
   // The same render without motion blur: other frames of front_right, same masks.
   rig["cameras"][1]["sensor"] = nullptr;
+  rig["cameras"][2]["sensor"] = nullptr;
   WriteText(dir / "rig.json", rig.dump());
   options.out = dir / "sharp";
   const fs::path sharp = RunRenderJob(options);
   EXPECT_NE(ReadText(seq / "frames/front_right/000003.png"), ReadText(sharp / "frames/front_right/000003.png"));
   EXPECT_EQ(ReadText(seq / "truth/masks/front_right/000003.png"),
             ReadText(sharp / "truth/masks/front_right/000003.png"));
+  // The jittered camera saw the (fast) motion at other instants.
+  EXPECT_NE(ReadText(seq / "truth/masks/overhead/000003.png"),
+            ReadText(sharp / "truth/masks/overhead/000003.png"));
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, DeterminismTest,

@@ -160,6 +160,7 @@ std::optional<SensorSetup> SensorPreset(const std::string& name) {
     s.optics.glare_gain = 0.6;
     s.optics.motion_blur_samples = 4;
     s.capture.drop_rate = 0.01;
+    s.capture.sync_jitter_ms = 2.0;
     return s;
   }
   return std::nullopt;
@@ -179,7 +180,8 @@ void ApplySensorOverrides(const nlohmann::json& overrides,
     nlohmann::json merged = group == "sensor"    ? setup->sensor.ToJson()
                             : group == "flicker" ? setup->flicker.ToJson()
                             : group == "optics"  ? OpticsToJson(setup->optics)
-                                                 : nlohmann::json{{"drop_rate", setup->capture.drop_rate}};
+                                                 : nlohmann::json{{"drop_rate", setup->capture.drop_rate},
+                                                                  {"sync_jitter_ms", setup->capture.sync_jitter_ms}};
     for (const auto& [knob, value] : knobs.items()) {
       if (!merged.contains(knob)) throw InputError(file, group_field + "." + knob, "unknown knob");
       if (merged[knob].is_boolean() ? !value.is_boolean() : !value.is_number()) {
@@ -224,7 +226,9 @@ void ApplySensorOverrides(const nlohmann::json& overrides,
       CheckRange(o.motion_blur_samples, 1, 16, file, group_field + ".motion_blur_samples");
     } else if (group == "capture") {
       setup->capture.drop_rate = merged["drop_rate"];
+      setup->capture.sync_jitter_ms = merged["sync_jitter_ms"];
       CheckRange(setup->capture.drop_rate, 0, 0.5, file, group_field + ".drop_rate");
+      CheckRange(setup->capture.sync_jitter_ms, 0, 100, file, group_field + ".sync_jitter_ms");
     } else {
       FlickerParams& f = setup->flicker;
       f.screen_amplitude = merged["screen_amplitude"];

@@ -61,7 +61,8 @@ struct FlickerParams {
 
 // Capture faults, recorded in the truth.
 struct CaptureParams {
-  double drop_rate = 0.0;  // probability that a camera drops a frame (it repeats the last one)
+  double drop_rate = 0.0;      // probability that a camera drops a frame (it repeats the last one)
+  double sync_jitter_ms = 0.0; // std of a camera's capture instant around the frame time
 };
 
 struct SensorSetup {

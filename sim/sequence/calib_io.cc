@@ -75,7 +75,8 @@ nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::vector
                    {"emva1288", sensors[i].sensor.ToJson()},
                    {"flicker", sensors[i].flicker.ToJson()},
                    {"optics", OpticsToJson(sensors[i].optics)},
-                   {"capture", {{"drop_rate", sensors[i].capture.drop_rate}}}};
+                   {"capture", {{"drop_rate", sensors[i].capture.drop_rate},
+                                {"sync_jitter_ms", sensors[i].capture.sync_jitter_ms}}}};
     j["cameras"].push_back(c);
   }
   return j;

@@ -296,36 +296,64 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   for (int f = 0; f < in.frame_count; ++f) {
     ThrowIfCancelled();
     const double t = f / in.fps;
-    if (blur_samples > 1) {
-      for (cv::Mat& sum : radiance_sums) sum.release();
-      for (int k = 0; k < blur_samples; ++k) {
-        const double offset = ((k + 0.5) / blur_samples - 0.5) * blur_exposure_s;
-        if (std::abs(offset) < 1e-12) continue;  // the centre sample is the final render
+    // Each camera's instant: the frame time, plus its sync jitter if any.
+    std::vector<double> instant(in.rig.cameras.size(), t);
+    bool jittered = false;
+    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+      const double jitter_s = in.sensor_active[c] ? in.sensors[c].capture.sync_jitter_ms / 1000.0 : 0.0;
+      if (jitter_s <= 0) continue;
+      float z0, z1;
+      StandardNormalPair(MixHash(MixHash(options.seed, 0x5C1Cull + c), uint64_t(f)), &z0, &z1);
+      instant[c] = t + jitter_s * z0;
+      jittered = true;
+    }
+    auto accumulate = [&](size_t c, const cv::Mat& grey) {
+      cv::Mat g;
+      grey.convertTo(g, CV_32F);
+      if (radiance_sums[c].empty()) radiance_sums[c] = g; else radiance_sums[c] += g;
+    };
+    for (cv::Mat& sum : radiance_sums) sum.release();
+    // Sub-frame offsets over the exposure; with an odd count the centre one is
+    // the final render at the camera's instant.
+    std::vector<double> offsets;
+    for (int k = 0; blur_samples > 1 && k < blur_samples; ++k) {
+      const double offset = ((k + 0.5) / blur_samples - 0.5) * blur_exposure_s;
+      if (std::abs(offset) > 1e-12) offsets.push_back(offset);
+    }
+    const bool centre_counts = blur_samples > 1 && blur_samples % 2 == 1;
+    if (!jittered) {
+      // Synchronised cameras share every render.
+      for (double offset : offsets) {
         PoseAndUpload(in, t + offset, renderer, skinned);
         renderer.RenderAll(&all_images, false);
-        for (size_t c = 0; c < all_images.size(); ++c) {
-          cv::Mat g;
-          all_images[c].grey.convertTo(g, CV_32F);
-          if (radiance_sums[c].empty()) radiance_sums[c] = g; else radiance_sums[c] += g;
+        for (size_t c = 0; c < all_images.size(); ++c) accumulate(c, all_images[c].grey);
+      }
+      PoseAndUpload(in, t, renderer, skinned);
+      renderer.RenderAll(&all_images, need_depth);
+      for (size_t c = 0; centre_counts && c < all_images.size(); ++c) accumulate(c, all_images[c].grey);
+    } else {
+      // Each camera sees the person at its own instant (skinned per camera).
+      all_images.resize(in.rig.cameras.size());
+      for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+        for (double offset : offsets) {
+          PoseAndUpload(in, instant[c] + offset, renderer, skinned);
+          renderer.Render(static_cast<int>(c), &all_images[c], false);
+          accumulate(c, all_images[c].grey);
         }
+        PoseAndUpload(in, instant[c], renderer, skinned);
+        renderer.Render(static_cast<int>(c), &all_images[c], need_depth);
+        if (centre_counts) accumulate(c, all_images[c].grey);
       }
     }
-    const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);
-    renderer.RenderAll(&all_images, need_depth);
-    // With an odd count the centre sub-frame is this render.
+    const JointTransforms world_from_joint =
+        ForwardKinematics(in.avatar.skeleton, in.motion->At(t));
     const int samples = blur_samples;
-    if (blur_samples > 1 && blur_samples % 2 == 1) {
-      for (size_t c = 0; c < all_images.size(); ++c) {
-        cv::Mat g;
-        all_images[c].grey.convertTo(g, CV_32F);
-        radiance_sums[c] += g;
-      }
-    }
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const std::string& cam_name = in.rig.cameras[c].name;
       const cv::Mat frame = expose(c, all_images[c].grey, radiance_sums[c], samples, all_images[c].depth,
-                                   t, f, sensor_truth);
+                                   instant[c], f, sensor_truth);
+      sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
       WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
       WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);
       if (options.write_depth) {
