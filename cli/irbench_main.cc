@@ -19,7 +19,10 @@ constexpr int kExitRuntime = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitInterrupted = 130;
 
-void AddRenderInputOptions(CLI::App* cmd, irbench::RenderJobOptions& o, std::string& backend) {
+void AddRenderInputOptions(CLI::App* cmd,
+                           irbench::RenderJobOptions& o,
+                           std::string& backend,
+                           std::string& shadows) {
   cmd->add_option("--scene", o.scene, "scene name (scenes/) or file; default: the rig's scene");
   cmd->add_option("--rig", o.rig, "camera rig name (rigs/) or file")->capture_default_str();
   cmd->add_option("--avatar", o.avatar, "avatar name (avatars/) or file")->capture_default_str();
@@ -30,13 +33,13 @@ void AddRenderInputOptions(CLI::App* cmd, irbench::RenderJobOptions& o, std::str
   cmd->add_option("--supersample", o.supersample, "pinhole pixels per output pixel per axis (1-4)")
       ->capture_default_str();
   cmd->add_option("--sensor", o.sensor, "sensor preset: clean, thesis or harsh")->capture_default_str();
-  cmd->add_option_function<std::string>(
-         "--shadows",
-         [&o](const std::string& v) {
-           if (v != "on" && v != "off") throw irbench::InputError("", "--shadows", "must be on or off");
-           o.shadows = v == "on";
-         },
-         "soft shadows of the scene's lights: on or off (default: on unless --sensor clean)");
+  cmd->add_option("--shadows", shadows,
+                  "soft shadows of the scene's lights: on or off (default: on unless --sensor clean)")
+      ->check(CLI::IsMember({"on", "off"}));
+}
+
+void ApplyShadows(const std::string& shadows, irbench::RenderJobOptions& o) {
+  if (!shadows.empty()) o.shadows = shadows == "on";
 }
 
 irbench::GlBackend BackendOrThrow(const std::string& name) {
@@ -61,10 +64,11 @@ int main(int argc, char** argv) {
   // render
   irbench::RenderJobOptions render;
   std::string render_backend = "auto";
+  std::string render_shadows, bench_shadows;
   int frames = 0;
   CLI::App* render_cmd = app.add_subcommand(
       "render", "Render a calibrated multi-camera sequence with exact truth into a folder");
-  AddRenderInputOptions(render_cmd, render, render_backend);
+  AddRenderInputOptions(render_cmd, render, render_backend, render_shadows);
   render_cmd->add_option("--frames", frames, "frames to render (default: the motion's length)");
   render_cmd->add_option("--background-frames", render.background_frames,
                          "empty-stage frames per camera")
@@ -84,7 +88,7 @@ int main(int argc, char** argv) {
   int bench_frames = 60;
   CLI::App* bench_render = bench_cmd->add_subcommand(
       "render", "Frame-sets per second of the render path at 1x and 2x the rig's resolution\n(320x240 and 640x480 for the shipped rigs)");
-  AddRenderInputOptions(bench_render, bench, bench_backend);
+  AddRenderInputOptions(bench_render, bench, bench_backend, bench_shadows);
   bench_render->add_option("--frames", bench_frames, "timed frame-sets per resolution")
       ->capture_default_str();
 
@@ -97,7 +101,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "error: " << e.what() << "\n(run with --help for usage)\n";
+    std::cerr << "error: " << e.what() << " (see --help)\n";
     return kExitBadInput;
   }
   irbench::SetVerbosity(verbosity);
@@ -108,12 +112,14 @@ int main(int argc, char** argv) {
       if (render_cmd->count("--frames") > 0) render.frames = frames;
       render.out = out;
       render.backend = BackendOrThrow(render_backend);
+      ApplyShadows(render_shadows, render);
       const std::filesystem::path folder = irbench::RunRenderJob(render);
       std::cout << folder.string() << "\n";
       return kExitOk;
     }
     if (bench_render->parsed()) {
       bench.backend = BackendOrThrow(bench_backend);
+      ApplyShadows(bench_shadows, bench);
       if (bench_frames < 1) throw irbench::InputError("", "--frames", "must be at least 1");
       std::string backend_description;
       const auto results =

@@ -91,6 +91,7 @@ TEST(CliTest, BadInputGivesOneLineExitTwoAndNothingBehind) {
        {"input.json", "line"}},
       {"missing_parent", "", {"--out", "@dir/no/such/parent/seq"}, {"--out", "does not exist"}},
       {"bad_backend", "", {"--backend", "vulkan"}, {"--backend"}},
+      {"bad_shadows", "", {"--shadows", "maybe"}, {"--shadows"}},
       {"bad_sensor_knob",
        RigWith(std::string(kGoodCamera).substr(0, std::string(kGoodCamera).size() - 1) +
                R"(, "sensor": {"sensor": {"prnu": 5}}})"),
