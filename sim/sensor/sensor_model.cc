@@ -1,6 +1,7 @@
 #include "sim/sensor/sensor_model.h"
 
 #include <cmath>
+#include <type_traits>
 
 #include "common/error.h"
 
@@ -41,6 +42,100 @@ uint64_t StringHash(const std::string& s) {
   return h;
 }
 
+// Every knob of a group, once: its name and member. Writing JSON, applying a
+// rig's overrides and naming bad fields all go through these tables.
+template <class F>
+void VisitKnobs(SensorParams& p, F&& f) {
+  f("photons_per_ms", p.photons_per_ms);
+  f("quantum_efficiency", p.quantum_efficiency);
+  f("full_well_e", p.full_well_e);
+  f("system_gain_dn_per_e", p.system_gain_dn_per_e);
+  f("dark_noise_e", p.dark_noise_e);
+  f("dark_current_e_per_s", p.dark_current_e_per_s);
+  f("dsnu_e", p.dsnu_e);
+  f("prnu", p.prnu);
+  f("bit_depth", p.bit_depth);
+  f("black_level_dn", p.black_level_dn);
+  f("tone_lift", p.tone_lift);
+  f("tone_ceiling_drop", p.tone_ceiling_drop);
+  f("tone_gamma", p.tone_gamma);
+  f("noise", p.noise);
+}
+
+template <class F>
+void VisitKnobs(FlickerParams& p, F&& f) {
+  f("screen_amplitude", p.screen_amplitude);
+  f("cut_rate_hz", p.cut_rate_hz);
+  f("fade_s", p.fade_s);
+  f("flash_rate_hz", p.flash_rate_hz);
+  f("flash_gain", p.flash_gain);
+  f("flash_s", p.flash_s);
+  f("mains_hz", p.mains_hz);
+  f("mains_depth", p.mains_depth);
+}
+
+template <class F>
+void VisitKnobs(OpticsParams& p, F&& f) {
+  f("f_number", p.f_number);
+  f("focal_length_mm", p.focal_length_mm);
+  f("focus_distance_m", p.focus_distance_m);
+  f("vignetting", p.vignetting);
+  f("glare_gain", p.glare_gain);
+  f("glare_threshold", p.glare_threshold);
+  f("glare_sigma_px", p.glare_sigma_px);
+  f("motion_blur_samples", p.motion_blur_samples);
+}
+
+template <class F>
+void VisitKnobs(CaptureParams& p, F&& f) {
+  f("drop_rate", p.drop_rate);
+  f("sync_jitter_ms", p.sync_jitter_ms);
+}
+
+template <class P>
+nlohmann::json KnobsToJson(const P& params) {
+  nlohmann::json j = nlohmann::json::object();
+  P copy = params;
+  VisitKnobs(copy, [&](const char* name, const auto& value) { j[name] = value; });
+  return j;
+}
+
+// Sets the knobs named in `knobs`; unknown names and wrong types throw.
+template <class P>
+void ApplyKnobs(const nlohmann::json& knobs, const std::string& file, const std::string& field, P* params) {
+  if (!knobs.is_object()) throw InputError(file, field, "expected an object");
+  for (const auto& [key, value] : knobs.items()) {
+    bool known = false;
+    VisitKnobs(*params, [&](const char* name, auto& member) {
+      if (key != name) return;
+      known = true;
+      using T = std::decay_t<decltype(member)>;
+      const bool ok = std::is_same_v<T, bool>  ? value.is_boolean()
+                      : std::is_same_v<T, int> ? value.is_number_integer()
+                                               : value.is_number();
+      if (!ok) throw InputError(file, field + "." + key, "wrong type: " + value.dump());
+      member = value.template get<T>();
+    });
+    if (!known) throw InputError(file, field + "." + key, "unknown knob");
+  }
+}
+
+void CheckOptics(const OpticsParams& o, const std::string& file, const std::string& p) {
+  CheckRange(o.f_number, 0, 64, file, p + "f_number");
+  CheckRange(o.focal_length_mm, 0.5, 500, file, p + "focal_length_mm");
+  CheckRange(o.focus_distance_m, 0.1, 1000, file, p + "focus_distance_m");
+  CheckRange(o.vignetting, 0, 1, file, p + "vignetting");
+  CheckRange(o.glare_gain, 0, 10, file, p + "glare_gain");
+  CheckRange(o.glare_threshold, 0, 10, file, p + "glare_threshold");
+  CheckRange(o.glare_sigma_px, 0.5, 100, file, p + "glare_sigma_px");
+  CheckRange(o.motion_blur_samples, 1, 16, file, p + "motion_blur_samples");
+}
+
+void CheckCapture(const CaptureParams& c, const std::string& file, const std::string& p) {
+  CheckRange(c.drop_rate, 0, 0.5, file, p + "drop_rate");
+  CheckRange(c.sync_jitter_ms, 0, 100, file, p + "sync_jitter_ms");
+}
+
 }  // namespace
 
 void SensorParams::Check(const std::string& file, const std::string& p) const {
@@ -59,22 +154,7 @@ void SensorParams::Check(const std::string& file, const std::string& p) const {
   CheckRange(tone_gamma, 0.1, 10, file, p + "tone_gamma");
 }
 
-nlohmann::json SensorParams::ToJson() const {
-  return {{"photons_per_ms", photons_per_ms},
-          {"quantum_efficiency", quantum_efficiency},
-          {"full_well_e", full_well_e},
-          {"system_gain_dn_per_e", system_gain_dn_per_e},
-          {"dark_noise_e", dark_noise_e},
-          {"dark_current_e_per_s", dark_current_e_per_s},
-          {"dsnu_e", dsnu_e},
-          {"prnu", prnu},
-          {"bit_depth", bit_depth},
-          {"black_level_dn", black_level_dn},
-          {"tone_lift", tone_lift},
-          {"tone_ceiling_drop", tone_ceiling_drop},
-          {"tone_gamma", tone_gamma},
-          {"noise", noise}};
-}
+nlohmann::json SensorParams::ToJson() const { return KnobsToJson(*this); }
 
 void FlickerParams::Check(const std::string& file, const std::string& p) const {
   CheckRange(screen_amplitude, 0, 1, file, p + "screen_amplitude");
@@ -87,23 +167,10 @@ void FlickerParams::Check(const std::string& file, const std::string& p) const {
   CheckRange(mains_depth, 0, 1, file, p + "mains_depth");
 }
 
-nlohmann::json FlickerParams::ToJson() const {
-  return {{"screen_amplitude", screen_amplitude}, {"cut_rate_hz", cut_rate_hz},
-          {"fade_s", fade_s},                     {"flash_rate_hz", flash_rate_hz},
-          {"flash_gain", flash_gain},             {"flash_s", flash_s},
-          {"mains_hz", mains_hz},                 {"mains_depth", mains_depth}};
-}
+nlohmann::json FlickerParams::ToJson() const { return KnobsToJson(*this); }
 
-nlohmann::json OpticsToJson(const OpticsParams& o) {
-  return {{"f_number", o.f_number},
-          {"focal_length_mm", o.focal_length_mm},
-          {"focus_distance_m", o.focus_distance_m},
-          {"vignetting", o.vignetting},
-          {"glare_gain", o.glare_gain},
-          {"glare_threshold", o.glare_threshold},
-          {"glare_sigma_px", o.glare_sigma_px},
-          {"motion_blur_samples", o.motion_blur_samples}};
-}
+nlohmann::json OpticsToJson(const OpticsParams& optics) { return KnobsToJson(optics); }
+nlohmann::json CaptureToJson(const CaptureParams& capture) { return KnobsToJson(capture); }
 
 std::optional<SensorSetup> SensorPreset(const std::string& name) {
   SensorSetup s;
@@ -172,74 +239,21 @@ void ApplySensorOverrides(const nlohmann::json& overrides,
                           SensorSetup* setup) {
   if (!overrides.is_object()) throw InputError(file, prefix, "expected an object");
   for (const auto& [group, knobs] : overrides.items()) {
-    const std::string group_field = prefix + "." + group;
-    if (group != "sensor" && group != "flicker" && group != "optics" && group != "capture") {
-      throw InputError(file, group_field, "unknown group (sensor, flicker, optics, capture)");
-    }
-    if (!knobs.is_object()) throw InputError(file, group_field, "expected an object");
-    nlohmann::json merged = group == "sensor"    ? setup->sensor.ToJson()
-                            : group == "flicker" ? setup->flicker.ToJson()
-                            : group == "optics"  ? OpticsToJson(setup->optics)
-                                                 : nlohmann::json{{"drop_rate", setup->capture.drop_rate},
-                                                                  {"sync_jitter_ms", setup->capture.sync_jitter_ms}};
-    for (const auto& [knob, value] : knobs.items()) {
-      if (!merged.contains(knob)) throw InputError(file, group_field + "." + knob, "unknown knob");
-      if (merged[knob].is_boolean() ? !value.is_boolean() : !value.is_number()) {
-        throw InputError(file, group_field + "." + knob, "wrong type: " + value.dump());
-      }
-      merged[knob] = value;
-    }
+    const std::string field = prefix + "." + group;
     if (group == "sensor") {
-      SensorParams& s = setup->sensor;
-      s.photons_per_ms = merged["photons_per_ms"];
-      s.quantum_efficiency = merged["quantum_efficiency"];
-      s.full_well_e = merged["full_well_e"];
-      s.system_gain_dn_per_e = merged["system_gain_dn_per_e"];
-      s.dark_noise_e = merged["dark_noise_e"];
-      s.dark_current_e_per_s = merged["dark_current_e_per_s"];
-      s.dsnu_e = merged["dsnu_e"];
-      s.prnu = merged["prnu"];
-      s.bit_depth = merged["bit_depth"].get<int>();
-      s.black_level_dn = merged["black_level_dn"];
-      s.tone_lift = merged["tone_lift"];
-      s.tone_ceiling_drop = merged["tone_ceiling_drop"];
-      s.tone_gamma = merged["tone_gamma"];
-      s.noise = merged["noise"];
-      s.Check(file, group_field + ".");
+      ApplyKnobs(knobs, file, field, &setup->sensor);
+      setup->sensor.Check(file, field + ".");
+    } else if (group == "flicker") {
+      ApplyKnobs(knobs, file, field, &setup->flicker);
+      setup->flicker.Check(file, field + ".");
     } else if (group == "optics") {
-      OpticsParams& o = setup->optics;
-      o.f_number = merged["f_number"];
-      o.focal_length_mm = merged["focal_length_mm"];
-      o.focus_distance_m = merged["focus_distance_m"];
-      o.vignetting = merged["vignetting"];
-      o.glare_gain = merged["glare_gain"];
-      o.glare_threshold = merged["glare_threshold"];
-      o.glare_sigma_px = merged["glare_sigma_px"];
-      o.motion_blur_samples = static_cast<int>(merged["motion_blur_samples"].get<double>());
-      CheckRange(o.f_number, 0, 64, file, group_field + ".f_number");
-      CheckRange(o.focal_length_mm, 0.5, 500, file, group_field + ".focal_length_mm");
-      CheckRange(o.focus_distance_m, 0.1, 1000, file, group_field + ".focus_distance_m");
-      CheckRange(o.vignetting, 0, 1, file, group_field + ".vignetting");
-      CheckRange(o.glare_gain, 0, 10, file, group_field + ".glare_gain");
-      CheckRange(o.glare_threshold, 0, 10, file, group_field + ".glare_threshold");
-      CheckRange(o.glare_sigma_px, 0.5, 100, file, group_field + ".glare_sigma_px");
-      CheckRange(o.motion_blur_samples, 1, 16, file, group_field + ".motion_blur_samples");
+      ApplyKnobs(knobs, file, field, &setup->optics);
+      CheckOptics(setup->optics, file, field + ".");
     } else if (group == "capture") {
-      setup->capture.drop_rate = merged["drop_rate"];
-      setup->capture.sync_jitter_ms = merged["sync_jitter_ms"];
-      CheckRange(setup->capture.drop_rate, 0, 0.5, file, group_field + ".drop_rate");
-      CheckRange(setup->capture.sync_jitter_ms, 0, 100, file, group_field + ".sync_jitter_ms");
+      ApplyKnobs(knobs, file, field, &setup->capture);
+      CheckCapture(setup->capture, file, field + ".");
     } else {
-      FlickerParams& f = setup->flicker;
-      f.screen_amplitude = merged["screen_amplitude"];
-      f.cut_rate_hz = merged["cut_rate_hz"];
-      f.fade_s = merged["fade_s"];
-      f.flash_rate_hz = merged["flash_rate_hz"];
-      f.flash_gain = merged["flash_gain"];
-      f.flash_s = merged["flash_s"];
-      f.mains_hz = merged["mains_hz"];
-      f.mains_depth = merged["mains_depth"];
-      f.Check(file, group_field + ".");
+      throw InputError(file, field, "unknown group (sensor, flicker, optics, capture)");
     }
   }
 }

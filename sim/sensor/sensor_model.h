@@ -74,6 +74,7 @@ struct SensorSetup {
 };
 
 nlohmann::json OpticsToJson(const OpticsParams& optics);
+nlohmann::json CaptureToJson(const CaptureParams& capture);
 
 // "clean" (no noise, no flicker, linear), "thesis" (the thesis's 1.2: dark,
 // flickering, washed out, grainy), "harsh". nullopt for unknown names.

@@ -75,8 +75,7 @@ nlohmann::json CamerasJson(const std::vector<Camera>& cameras, const std::vector
                    {"emva1288", sensors[i].sensor.ToJson()},
                    {"flicker", sensors[i].flicker.ToJson()},
                    {"optics", OpticsToJson(sensors[i].optics)},
-                   {"capture", {{"drop_rate", sensors[i].capture.drop_rate},
-                                {"sync_jitter_ms", sensors[i].capture.sync_jitter_ms}}}};
+                   {"capture", CaptureToJson(sensors[i].capture)}};
     j["cameras"].push_back(c);
   }
   return j;
