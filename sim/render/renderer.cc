@@ -469,13 +469,17 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   shadows_dirty_ = true;
 }
 
-void Renderer::DrawGeometry() {
+void Renderer::DrawGeometry(int person_flag_location) {
+  // Near to far: the person, then the scene (rooms last), for early depth
+  // rejection. A location of -1 (the shadow pass) makes Uniform1f a no-op.
   const GlFunctions& gl = gl_;
   if (person_visible_ && person_index_count_ > 0) {
+    gl.Uniform1f(person_flag_location, 1.0f);
     gl.BindVertexArray(person_vao_);
     gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
   }
   if (static_index_count_ > 0) {
+    gl.Uniform1f(person_flag_location, 0.0f);
     gl.BindVertexArray(static_vao_);
     gl.DrawElements(GL_TRIANGLES, static_index_count_, GL_UNSIGNED_INT, nullptr);
   }
@@ -499,7 +503,7 @@ void Renderer::UpdateShadows() {
                         map->clip_from_world.data());
     gl.UniformMatrix4fv(gl.GetUniformLocation(shadow_program_, "u_cam_from_world"), 1, GL_FALSE,
                         map->cam_from_world.data());
-    DrawGeometry();
+    DrawGeometry(-1);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   shadows_dirty_ = false;
@@ -568,19 +572,7 @@ void Renderer::Draw(int index) {
     gl.BindTexture(GL_TEXTURE_2D_ARRAY, shadow_array_);
     gl.ActiveTexture(GL_TEXTURE0);
   }
-  const GLint person_loc = gl.GetUniformLocation(program_, "u_person");
-  // Near to far: the person, then the scene (rooms last), for early depth rejection.
-  if (person_visible_ && person_index_count_ > 0) {
-    gl.Uniform1f(person_loc, 1.0f);
-    gl.BindVertexArray(person_vao_);
-    gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
-  }
-  if (static_index_count_ > 0) {
-    gl.Uniform1f(person_loc, 0.0f);
-    gl.BindVertexArray(static_vao_);
-    gl.DrawElements(GL_TRIANGLES, static_index_count_, GL_UNSIGNED_INT, nullptr);
-  }
-  gl.BindVertexArray(0);
+  DrawGeometry(gl.GetUniformLocation(program_, "u_person"));
 }
 
 void Renderer::Read(int index, CameraImages* out, bool want_depth) {

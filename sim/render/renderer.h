@@ -82,7 +82,7 @@ class Renderer {
   struct Target;
   struct ShadowMap;
   void UpdateShadows();
-  void DrawGeometry();
+  void DrawGeometry(int person_flag_location);
   void Draw(int index);
   void Read(int index, CameraImages* out, bool want_depth);
   GlContext& context_;
