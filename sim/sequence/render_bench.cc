@@ -21,10 +21,7 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
     std::vector<Camera> cameras;
     for (const Camera& cam : base_cameras) cameras.push_back(cam.Scaled(scale));
     in.rig.cameras = cameras;
-    RenderOptions render_options;
-    render_options.supersample = options.supersample;
-    render_options.shadows = options.shadows.value_or(options.sensor != "clean");
-    Renderer renderer(*context, cameras, render_options);
+    Renderer renderer(*context, cameras, RenderOptionsFor(options));
     renderer.SetScene(in.scene);
     renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
     std::vector<MeshVertex> skinned;
@@ -36,10 +33,12 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
     for (bool encode : {false, true}) {
       // Five warm-up frame-sets (shader variants compile on first use), then
       // the timed ones.
+      std::chrono::steady_clock::time_point start;
       for (int f = -5; f < frames; ++f) {
-        if (f == 0) Log().debug("bench: timing {} encode={}", result.label, encode);
-        static thread_local std::chrono::steady_clock::time_point start;
-        if (f == 0) start = std::chrono::steady_clock::now();
+        if (f == 0) {
+          Log().debug("bench: timing {} encode={}", result.label, encode);
+          start = std::chrono::steady_clock::now();
+        }
         ThrowIfCancelled();
         const double t = std::max(0, f) / in.fps;
         const JointTransforms world_from_joint = PoseAndUpload(in, t, renderer, skinned);

@@ -88,6 +88,13 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   return in;
 }
 
+RenderOptions RenderOptionsFor(const RenderJobOptions& options) {
+  RenderOptions render_options;
+  render_options.supersample = options.supersample;
+  render_options.shadows = options.shadows.value_or(options.sensor != "clean");
+  return render_options;
+}
+
 JointTransforms PoseAndUpload(const RenderInputs& inputs,
                               double t,
                               Renderer& renderer,
@@ -141,9 +148,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   // 2. GL and the renderer.
   auto context = CreateGlContext(options.backend);
   Log().info("render: {} backend, {}", context->BackendName(), context->RendererString());
-  RenderOptions render_options;
-  render_options.supersample = options.supersample;
-  render_options.shadows = options.shadows.value_or(options.sensor != "clean");
+  const RenderOptions render_options = RenderOptionsFor(options);
   Renderer renderer(*context, in.rig.cameras, render_options);
   renderer.SetScene(in.scene);
   renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());

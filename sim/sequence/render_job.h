@@ -54,6 +54,10 @@ struct RenderInputs {
 
 RenderInputs LoadRenderInputs(const RenderJobOptions& options);
 
+// The renderer's options for a job: its supersampling, and shadows unless
+// turned off (default: on for every sensor preset but clean).
+RenderOptions RenderOptionsFor(const RenderJobOptions& options);
+
 // Per-frame truth joints and their projections, for one posed frame.
 struct FrameTruth {
   std::vector<Eigen::Vector3d> joints3d;  // TruthJointNames() order
