@@ -298,6 +298,14 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   std::string truth_lines;
   const auto& joint_names = TruthJointNames();
   std::vector<cv::Mat> radiance_sums(in.rig.cameras.size());
+  // Sub-frame offsets over the exposure; with an odd count the centre one is
+  // the final render at the camera's instant.
+  std::vector<double> offsets;
+  for (int k = 0; blur_samples > 1 && k < blur_samples; ++k) {
+    const double offset = ((k + 0.5) / blur_samples - 0.5) * blur_exposure_s;
+    if (std::abs(offset) > 1e-12) offsets.push_back(offset);
+  }
+  const bool centre_counts = blur_samples > 1 && blur_samples % 2 == 1;
   for (int f = 0; f < in.frame_count; ++f) {
     ThrowIfCancelled();
     const double t = f / in.fps;
@@ -318,14 +326,6 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
       if (radiance_sums[c].empty()) radiance_sums[c] = g; else radiance_sums[c] += g;
     };
     for (cv::Mat& sum : radiance_sums) sum.release();
-    // Sub-frame offsets over the exposure; with an odd count the centre one is
-    // the final render at the camera's instant.
-    std::vector<double> offsets;
-    for (int k = 0; blur_samples > 1 && k < blur_samples; ++k) {
-      const double offset = ((k + 0.5) / blur_samples - 0.5) * blur_exposure_s;
-      if (std::abs(offset) > 1e-12) offsets.push_back(offset);
-    }
-    const bool centre_counts = blur_samples > 1 && blur_samples % 2 == 1;
     if (!jittered) {
       // Synchronised cameras share every render.
       for (double offset : offsets) {
@@ -352,12 +352,11 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     }
     const JointTransforms world_from_joint =
         ForwardKinematics(in.avatar.skeleton, in.motion->At(t));
-    const int samples = blur_samples;
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const std::string& cam_name = in.rig.cameras[c].name;
-      const cv::Mat frame = expose(c, all_images[c].grey, radiance_sums[c], samples, all_images[c].depth,
-                                   instant[c], f, sensor_truth);
+      const cv::Mat frame = expose(c, all_images[c].grey, radiance_sums[c], blur_samples,
+                                   all_images[c].depth, instant[c], f, sensor_truth);
       sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
       WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
       WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);
