@@ -4,15 +4,6 @@
 #include <cmath>
 
 namespace irbench {
-namespace {
-
-// Uniform in [0, 1) from a counter.
-double Uniform(uint64_t stream, uint64_t counter) {
-  return double(MixHash(stream, counter) >> 11) / 9007199254740992.0;
-}
-
-}  // namespace
-
 FlickerModel::FlickerModel(const FlickerParams& params, uint64_t seed, double start_s, double end_s)
     : params_(params) {
   const uint64_t stream = MixHash(seed, 0xF11C4E5ull);
@@ -22,7 +13,7 @@ FlickerModel::FlickerModel(const FlickerParams& params, uint64_t seed, double st
     // Cuts form a Poisson process; each sets a new level 1 + amplitude * N(0, 1).
     double t = start_s - 1.0;
     while (true) {
-      t += -std::log(1.0 - Uniform(stream, counter++)) / params.cut_rate_hz;
+      t += -std::log(1.0 - UniformFromHash(stream, counter++)) / params.cut_rate_hz;
       if (t > end_s + 1.0) break;
       float z0, z1;
       StandardNormalPair(MixHash(stream, counter++), &z0, &z1);
@@ -32,12 +23,12 @@ FlickerModel::FlickerModel(const FlickerParams& params, uint64_t seed, double st
   if (params.flash_rate_hz > 0) {
     double t = start_s - 1.0;
     while (true) {
-      t += -std::log(1.0 - Uniform(stream, counter++)) / params.flash_rate_hz;
+      t += -std::log(1.0 - UniformFromHash(stream, counter++)) / params.flash_rate_hz;
       if (t > end_s + 1.0) break;
       flashes_.push_back(t);
     }
   }
-  mains_phase_ = 2 * M_PI * Uniform(stream, counter++);
+  mains_phase_ = 2 * M_PI * UniformFromHash(stream, counter++);
 }
 
 double FlickerModel::ScreenLevel(double t) const {

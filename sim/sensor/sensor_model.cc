@@ -3,6 +3,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 
 namespace irbench {
@@ -13,6 +14,10 @@ uint64_t MixHash(uint64_t a, uint64_t b) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
+}
+
+double UniformFromHash(uint64_t stream, uint64_t counter) {
+  return double(MixHash(stream, counter) >> 11) / 9007199254740992.0;  // 53 bits / 2^53
 }
 
 void StandardNormalPair(uint64_t counter, float* z0, float* z1) {
@@ -34,12 +39,6 @@ void CheckRange(double value, double lo, double hi, const std::string& file, con
                      "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " +
                          std::to_string(value) + ")");
   }
-}
-
-uint64_t StringHash(const std::string& s) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  return h;
 }
 
 // Every knob of a group, once: its name and member. Writing JSON, applying a
@@ -263,7 +262,7 @@ SensorModel::SensorModel(const SensorParams& params,
                          const std::string& camera,
                          int width,
                          int height)
-    : params_(params), stream_(MixHash(seed, StringHash(camera))) {
+    : params_(params), stream_(MixHash(seed, Fnv1a64(camera))) {
   prnu_.create(height, width, CV_32FC1);
   dsnu_.create(height, width, CV_32FC1);
   const uint64_t pattern_stream = MixHash(stream_, 0x5EED);

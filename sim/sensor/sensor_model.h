@@ -113,6 +113,8 @@ class SensorModel {
 // Counter-based randomness: a 64-bit hash, and two independent standard
 // normals from one counter (Box–Muller).
 uint64_t MixHash(uint64_t a, uint64_t b);
+// A uniform number in [0, 1) from MixHash(stream, counter).
+double UniformFromHash(uint64_t stream, uint64_t counter);
 void StandardNormalPair(uint64_t counter, float* z0, float* z1);
 
 }  // namespace irbench

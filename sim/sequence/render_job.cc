@@ -255,8 +255,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     // The exposure is centred on the frame time, where the truth is.
     const double exposure_s = cam.exposure_ms / 1000.0;
     const double level = flickers[c].Level(t - 0.5 * exposure_s, exposure_s);
-    const double drop_u =
-        double(MixHash(MixHash(options.seed, 0xD50Bull + c), noise_frame) >> 11) / 9007199254740992.0;
+    const double drop_u = UniformFromHash(MixHash(options.seed, 0xD50Bull + c), noise_frame);
     const bool dropped = drop_u < in.sensors[c].capture.drop_rate && !last_written[c].empty();
     sensor_truth[cam.name] = {{"flicker", level}, {"exposure_ms", cam.exposure_ms}, {"dropped", dropped}};
     if (dropped) return last_written[c];
