@@ -10,18 +10,14 @@
 namespace irbench {
 namespace fs = std::filesystem;
 
-void AtomicWriteFile(const fs::path& path, std::string_view bytes) {
+void AtomicWriteWith(const fs::path& path, const std::function<void(const fs::path&)>& write) {
   const fs::path tmp = path.parent_path() /
                        ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
-  {
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (f == nullptr) throw RuntimeError("cannot write " + tmp.string());
-    const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), f);
-    const bool ok = written == bytes.size() && std::fclose(f) == 0;
-    if (!ok) {
-      std::remove(tmp.c_str());
-      throw RuntimeError("write failed (disk full?): " + path.string());
-    }
+  try {
+    write(tmp);
+  } catch (const std::exception& e) {
+    std::remove(tmp.c_str());
+    throw RuntimeError("cannot write " + path.string() + ": " + e.what());
   }
   std::error_code ec;
   fs::rename(tmp, path, ec);
@@ -29,6 +25,15 @@ void AtomicWriteFile(const fs::path& path, std::string_view bytes) {
     std::remove(tmp.c_str());
     throw RuntimeError("cannot rename into " + path.string() + ": " + ec.message());
   }
+}
+
+void AtomicWriteFile(const fs::path& path, std::string_view bytes) {
+  AtomicWriteWith(path, [&](const fs::path& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (f == nullptr) throw RuntimeError("cannot open " + tmp.string());
+    const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), f);
+    if (std::fclose(f) != 0 || written != bytes.size()) throw RuntimeError("write failed (disk full?)");
+  });
 }
 
 StagingDir::StagingDir(const fs::path& final_path, bool overwrite, const std::string& option)

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -13,6 +14,12 @@ namespace irbench {
 // Writes `bytes` to `path` via a temporary file in the same folder and rename().
 // Throws RuntimeError on I/O failure (the temporary is removed).
 void AtomicWriteFile(const std::filesystem::path& path, std::string_view bytes);
+
+// The same for writers that need a file name (image libraries): `write` fills
+// the temporary path it is given; on any exception the temporary is removed
+// and a RuntimeError naming `path` is thrown.
+void AtomicWriteWith(const std::filesystem::path& path,
+                     const std::function<void(const std::filesystem::path& temporary)>& write);
 
 // A folder that becomes `final_path` only on Commit(). Until then it lives at
 // `<parent>/.<name>.partial-<pid>`; the destructor removes it if not committed,

@@ -4,7 +4,6 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
-#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -27,9 +26,7 @@ void WritePngAtomic(const std::filesystem::path& path, const cv::Mat& image) {
 
 void WriteDepthExrAtomic(const std::filesystem::path& path, const cv::Mat& depth) {
   CV_Assert(depth.type() == CV_32FC1 && depth.isContinuous());
-  const std::filesystem::path tmp =
-      path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
-  try {
+  AtomicWriteWith(path, [&](const std::filesystem::path& tmp) {
     Imf::Header header(depth.cols, depth.rows);
     header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
     header.compression() = Imf::ZIP_COMPRESSION;
@@ -39,13 +36,7 @@ void WriteDepthExrAtomic(const std::filesystem::path& path, const cv::Mat& depth
                                         sizeof(float), sizeof(float) * depth.cols));
     file.setFrameBuffer(frame_buffer);
     file.writePixels(depth.rows);
-  } catch (const std::exception& e) {
-    std::filesystem::remove(tmp);
-    throw RuntimeError("cannot write " + path.string() + ": " + e.what());
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw RuntimeError("cannot rename into " + path.string() + ": " + ec.message());
+  });
 }
 
 }  // namespace irbench
