@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "sim/sensor/emva1288.h"
 #include "sim/sensor/flicker.h"
 
 namespace irbench {
@@ -51,34 +52,16 @@ double Variance(const cv::Mat& m) {
 TEST(SensorModelTest, PhotonTransferRecoversTheConfiguredSensor) {
   const SensorParams p = TestSensor();
   const SensorModel sensor(p, 42, "cam0", kWidth, kHeight);
-  std::vector<double> mu, var;
-  uint64_t frame = 0;
-  double dark_var_at_shortest = 0, shortest_ms = 0;
-  for (int level = 0; level < 12; ++level) {
-    const double exposure_ms = 0.25 + 0.4 * level;  // 250 .. 4650 electrons
-    const cv::Mat a = AsDouble(sensor.Expose(Flat(1.0f), exposure_ms, frame++));
-    const cv::Mat b = AsDouble(sensor.Expose(Flat(1.0f), exposure_ms, frame++));
-    const cv::Mat da = AsDouble(sensor.Expose(Flat(0.0f), exposure_ms, frame++));
-    const cv::Mat db = AsDouble(sensor.Expose(Flat(0.0f), exposure_ms, frame++));
-    const double mu_y = 0.5 * (Mean(a) + Mean(b)), mu_dark = 0.5 * (Mean(da) + Mean(db));
-    const double var_y = 0.5 * Variance(a - b), var_dark = 0.5 * Variance(da - db);
-    mu.push_back(mu_y - mu_dark);
-    var.push_back(var_y - var_dark);
-    if (level == 0) {
-      dark_var_at_shortest = var_dark;
-      shortest_ms = exposure_ms;
-    }
-  }
-  // Least-squares slope through the origin.
-  double sxy = 0, sxx = 0;
-  for (size_t i = 0; i < mu.size(); ++i) sxy += mu[i] * var[i], sxx += mu[i] * mu[i];
-  const double gain = sxy / sxx;
+  std::vector<double> exposures_ms;
+  for (int level = 0; level < 12; ++level) exposures_ms.push_back(0.25 + 0.4 * level);  // 250 .. 4650 e-
+  const PhotonTransfer ptc = MeasurePhotonTransfer(sensor, Flat(1.0f), Flat(0.0f), exposures_ms, 0);
+  uint64_t frame = ptc.frames_used;
+  const double gain = ptc.gain_dn_per_e;
   EXPECT_NEAR(gain, p.system_gain_dn_per_e, 0.03 * p.system_gain_dn_per_e);
-  // Dark noise (EMVA: sigma_d^2 = (var_dark - 1/12) / K^2), which at this
-  // exposure includes the shot noise of the dark current.
-  const double dark_noise = std::sqrt(dark_var_at_shortest - 1.0 / 12) / gain;
+  // Dark noise at the shortest exposure includes the shot noise of its dark current.
+  const double dark_noise = ptc.dark_noise_e;
   const double expected_dark =
-      std::sqrt(p.dark_noise_e * p.dark_noise_e + p.dark_current_e_per_s * shortest_ms / 1000);
+      std::sqrt(p.dark_noise_e * p.dark_noise_e + p.dark_current_e_per_s * exposures_ms[0] / 1000);
   EXPECT_NEAR(dark_noise, expected_dark, 0.05 * expected_dark);
 
   // Spatial non-uniformities from averages of 32 frames (temporal variance
