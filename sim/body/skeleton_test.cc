@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include "sim/body/avatar.h"
-#include "sim/body/keyframes.h"
 
 namespace irbench {
 namespace {
@@ -44,28 +43,6 @@ TEST(SkeletonTest, ForwardKinematicsPreservesBoneLengths) {
     const int p = JointParent(j);
     const double bind_len = (avatar.skeleton.bind_position[j] - avatar.skeleton.bind_position[p]).norm();
     EXPECT_NEAR((t[j].translation() - t[p].translation()).norm(), bind_len, 1e-12) << JointName(j);
-  }
-}
-
-TEST(KeyframesTest, InterpolatesAndHolds) {
-  Keyframe a, b;
-  a.t = 0;
-  b.t = 2;
-  b.pose.root_offset = {1, 0, 0};
-  b.pose.local_rotation[kRightElbow] = RotationZXYDeg({0, 0, 90});
-  const KeyframeMotion motion("test", {a, b});
-  EXPECT_NEAR(motion.At(1.0).root_offset.x(), 0.5, 1e-12);  // smoothstep(0.5) = 0.5
-  EXPECT_NEAR(motion.At(0.5).root_offset.x(), 0.15625, 1e-12);  // smoothstep(0.25)
-  EXPECT_NEAR(Eigen::AngleAxisd(motion.At(1.0).local_rotation[kRightElbow]).angle(), M_PI / 4, 1e-9);
-  EXPECT_NEAR(motion.At(5.0).root_offset.x(), 1.0, 1e-12);
-  EXPECT_NEAR(motion.At(-1.0).root_offset.x(), 0.0, 1e-12);
-}
-
-TEST(KeyframesTest, ShippedMotionsLoad) {
-  for (const char* name : {"wave", "stand", "point", "enter_wave_leave"}) {
-    const auto motion =
-        LoadKeyframes(std::string(IRBENCH_SOURCE_DIR) + "/motions/" + name + ".json");
-    EXPECT_GT(motion.duration(), 1.0) << name;
   }
 }
 

@@ -11,6 +11,7 @@
 #include "common/paths.h"
 #include "sim/sequence/calib_io.h"
 #include "sim/sequence/image_io.h"
+#include "sim/motion/bvh.h"
 #include "sim/sensor/flicker.h"
 
 namespace irbench {
@@ -63,8 +64,15 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   in.scene = LoadScene(in.scene_file);
   in.avatar_file = ResolveDataFile("avatars", options.avatar, "--avatar");
   in.avatar = LoadAvatar(in.avatar_file);
-  in.motion_file = ResolveDataFile("motions", options.motion, "--motion");
-  in.motion = LoadKeyframes(in.motion_file);
+  MotionContext ctx;
+  ctx.avatar = &in.avatar;
+  ctx.scene = &in.scene;
+  ctx.style = StyleFor(in.avatar.params.name, options.seed);
+  in.style = ctx.style;
+  const ResolvedMotion resolved = ResolveMotion(options.motion, ctx, "--motion");
+  in.motion = resolved.motion;
+  in.motion_kind = resolved.kind;
+  in.motion_file = resolved.file;
   in.motion_name = in.motion->name();
   in.fps = in.rig.cameras.front().fps;
   for (size_t i = 1; i < in.rig.cameras.size(); ++i) {
@@ -84,7 +92,7 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
     in.sensors.push_back(setup);
   }
   in.frame_count = options.frames.value_or(
-      static_cast<int>(std::floor(in.motion->duration() * in.fps + 1e-9)) + 1);
+      static_cast<int>(std::floor(in.motion->Duration() * in.fps + 1e-9)) + 1);
   return in;
 }
 
@@ -182,8 +190,16 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
                         {"kind", "tube"},
                         {"build", in.avatar.params.build}};
   manifest["motion"] = {{"name", in.motion_name},
-                        {"file", in.motion_file.filename().string()},
-                        {"kind", "keyframes"}};
+                        {"file", in.motion_file.empty() ? nlohmann::json(nullptr)
+                                                        : nlohmann::json(in.motion_file.filename().string())},
+                        {"kind", in.motion_kind},
+                        {"duration_s", in.motion->Duration()},
+                        {"style", {{"tempo", in.style.tempo},
+                                   {"amplitude", in.style.amplitude},
+                                   {"asynchrony_s", in.style.asynchrony_s},
+                                   {"tremor_deg", in.style.tremor_deg},
+                                   {"tremor_hz", in.style.tremor_hz},
+                                   {"handedness", in.style.handedness > 0 ? "right" : "left"}}}};
   manifest["sensor"] = options.sensor;
   manifest["fps"] = in.fps;
   manifest["frame_count"] = in.frame_count;
@@ -202,7 +218,9 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
                        {"background", "background/<cam>/NNNNNN.png"},
                        {"masks", "truth/masks/<cam>/NNNNNN.png"},
                        {"truth", "truth/frames.jsonl"},
-                       {"background_truth", "truth/background.jsonl"}};
+                       {"background_truth", "truth/background.jsonl"},
+                       {"events", "truth/events.json"},
+                       {"motion_bvh", "truth/motion.bvh"}};
   if (options.write_depth) manifest["files"]["depth"] = "truth/depth/<cam>/NNNNNN.exr";
 
   const auto start = std::chrono::steady_clock::now();
@@ -295,6 +313,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   renderer.SetPersonVisible(true);
   std::vector<MeshVertex> skinned;
   std::string truth_lines;
+  const Labeler labeler(in.avatar, &in.scene, *in.motion);
   const auto& joint_names = TruthJointNames();
   std::vector<cv::Mat> radiance_sums(in.rig.cameras.size());
   // Sub-frame offsets over the exposure; with an odd count the centre one is
@@ -385,8 +404,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
       joints2d[in.rig.cameras[c].name] = per_cam;
     }
     line["joints2d"] = joints2d;
-    line["labels"] = {{"gesture", nullptr}, {"posture", nullptr}, {"rest", nullptr}, {"motion", nullptr}};
-    line["pointing"] = {{"left", nullptr}, {"right", nullptr}};
+    line["labels"] = labeler.Labels(t);
+    line["pointing"] = labeler.Pointing(t);
     line["sensor"] = sensor_truth;
     truth_lines += line.dump() + "\n";
     ++done;
@@ -394,6 +413,18 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   }
   AtomicWriteFile(root / "truth" / "frames.jsonl", truth_lines);
   AtomicWriteFile(root / "truth" / "background.jsonl", background_lines);
+  nlohmann::json events = nlohmann::json::array();
+  for (const MotionEvent& e : in.motion->Events()) {
+    events.push_back({{"kind", e.kind},
+                      {"value", e.value},
+                      {"side", e.side.empty() ? nlohmann::json(nullptr) : nlohmann::json(e.side)},
+                      {"start_s", e.start},
+                      {"end_s", e.end},
+                      {"start_frame", static_cast<int>(std::ceil(e.start * in.fps - 1e-9))},
+                      {"end_frame", static_cast<int>(std::floor(e.end * in.fps + 1e-9))}});
+  }
+  AtomicWriteFile(root / "truth" / "events.json", events.dump(2) + "\n");
+  AtomicWriteFile(root / "truth" / "motion.bvh", WriteBvh(MotionToBvh(*in.motion, in.avatar.skeleton, in.fps, in.frame_count)));
   AtomicWriteFile(root / "manifest.json", manifest.dump(2) + "\n");
   ThrowIfCancelled();
   staging.Commit();

@@ -9,7 +9,8 @@
 #include <string>
 
 #include "sim/body/avatar.h"
-#include "sim/body/keyframes.h"
+#include "sim/motion/labels.h"
+#include "sim/motion/session.h"
 #include "sim/camera/rig.h"
 #include "sim/gl/gl_context.h"
 #include "sim/render/renderer.h"
@@ -42,8 +43,10 @@ struct RenderInputs {
   Scene scene;
   Rig rig;
   Avatar avatar;
-  std::optional<KeyframeMotion> motion;
+  MotionPtr motion;
   std::string motion_name;
+  std::string motion_kind;  // library, keyframes, session, bvh, amc
+  MotionStyle style;
   std::filesystem::path scene_file, rig_file, avatar_file, motion_file;
   int frame_count = 0;
   double fps = 30;

@@ -1,4 +1,4 @@
-#include "sim/body/keyframes.h"
+#include "sim/motion/keyframes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,11 @@
 
 namespace irbench {
 
-KeyframeMotion::KeyframeMotion(std::string name, std::vector<Keyframe> keys)
-    : name_(std::move(name)), keys_(std::move(keys)) {}
+KeyframeMotion::KeyframeMotion(std::string name, std::vector<Keyframe> keys,
+                               std::vector<MotionEvent> events)
+    : MotionSource(std::move(name)), keys_(std::move(keys)), events_(std::move(events)) {
+  if (keys_.empty()) throw std::invalid_argument("KeyframeMotion needs at least one key");
+}
 
 Pose KeyframeMotion::At(double t) const {
   if (t <= keys_.front().t) return keys_.front().pose;

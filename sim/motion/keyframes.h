@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sim/body/skeleton.h"
+#include "sim/motion/motion_source.h"
 
 namespace irbench {
 
@@ -16,18 +17,20 @@ struct Keyframe {
   Pose pose;
 };
 
-class KeyframeMotion {
+class KeyframeMotion : public MotionSource {
  public:
-  KeyframeMotion(std::string name, std::vector<Keyframe> keys);
+  KeyframeMotion(std::string name, std::vector<Keyframe> keys,
+                 std::vector<MotionEvent> events = {});
 
-  const std::string& name() const { return name_; }
-  double duration() const { return keys_.back().t; }
+  double Duration() const override { return keys_.back().t; }
   // The pose at time t (held before the first and after the last key).
-  Pose At(double t) const;
+  Pose At(double t) const override;
+  std::vector<MotionEvent> Events() const override { return events_; }
+  const std::vector<Keyframe>& keys() const { return keys_; }
 
  private:
-  std::string name_;
   std::vector<Keyframe> keys_;
+  std::vector<MotionEvent> events_;
 };
 
 // Loads a keyframe file. Joint rotations are [x, y, z] degrees in the thesis's

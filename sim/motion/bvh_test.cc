@@ -1,0 +1,226 @@
+#include "sim/motion/bvh.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "common/error.h"
+#include "sim/body/avatar.h"
+#include "sim/motion/library.h"
+#include "sim/motion/retarget.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+
+const char* kSmallBvh =
+    "HIERARCHY\n"
+    "ROOT Hips\n"
+    "{\n"
+    "\tOFFSET 0 0 0\n"
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+    "\tJOINT Arm\n"
+    "\t{\n"
+    "\t\tOFFSET 10 0 0\n"
+    "\t\tCHANNELS 3 Zrotation Yrotation Xrotation\n"
+    "\t\tEnd Site\n"
+    "\t\t{\n"
+    "\t\t\tOFFSET 0 -5 0\n"
+    "\t\t}\n"
+    "\t}\n"
+    "}\n"
+    "MOTION\n"
+    "Frames:\t2\n"
+    "Frame Time:\t0.0083333\n"
+    "1 2 3 0 0 0 90 0 0\n"
+    "1 2 3 90 0 0 0 0 0\n";
+
+std::string Replace(std::string s, const std::string& from, const std::string& to) {
+  const size_t at = s.find(from);
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+// Line of an InputError's field "line N".
+int LineOf(const std::string& text) {
+  try {
+    ParseBvh(text, "bad.bvh");
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "bad.bvh");
+    EXPECT_EQ(e.field().rfind("line ", 0), 0u) << e.what();
+    return std::stoi(e.field().substr(5));
+  }
+  ADD_FAILURE() << "no error";
+  return -1;
+}
+
+TEST(BvhTest, ForwardKinematicsMatchesHandComputation) {
+  const MocapClip clip = BvhToClip(ParseBvh(kSmallBvh, "small.bvh"));
+  ASSERT_EQ(clip.joint_names.size(), 3u);
+  EXPECT_EQ(clip.joint_names[2], "Arm_end");
+  EXPECT_NEAR(clip.frame_time, 0.0083333, 1e-12);
+  // Frame 0: the Arm joint turns 90° about z; its end (0, -5, 0) goes to (5, 0, 0).
+  const Eigen::Vector3d end0 = clip.frames[0].position[2];
+  EXPECT_NEAR((end0 - Eigen::Vector3d(1 + 10 + 5, 2, 3)).norm(), 0, 1e-12);
+  // Frame 1: the root turns 90° about z: the arm offset (10, 0, 0) -> (0, 10, 0).
+  EXPECT_NEAR((clip.frames[1].position[1] - Eigen::Vector3d(1, 12, 3)).norm(), 0, 1e-12);
+  EXPECT_NEAR((clip.frames[1].position[2] - Eigen::Vector3d(1 + 5, 12, 3)).norm(), 0, 1e-12);
+}
+
+TEST(BvhTest, CrlfAndTabsParseLikeLf) {
+  std::string crlf;
+  for (char c : std::string(kSmallBvh)) {
+    if (c == '\n') crlf += "\r\n"; else crlf += (c == ' ' ? '\t' : c);
+  }
+  const BvhFile a = ParseBvh(kSmallBvh, "a.bvh"), b = ParseBvh(crlf, "b.bvh");
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_EQ(a.joints.size(), b.joints.size());
+}
+
+TEST(BvhTest, EulerDecompositionInvertsEveryOrder) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-170, 170), mid(-85, 85);
+  using C = BvhChannel;
+  const std::vector<std::vector<C>> orders = {
+      {C::kXrotation, C::kYrotation, C::kZrotation}, {C::kXrotation, C::kZrotation, C::kYrotation},
+      {C::kYrotation, C::kXrotation, C::kZrotation}, {C::kYrotation, C::kZrotation, C::kXrotation},
+      {C::kZrotation, C::kXrotation, C::kYrotation}, {C::kZrotation, C::kYrotation, C::kXrotation}};
+  for (const auto& order : orders) {
+    for (int i = 0; i < 50; ++i) {
+      const Eigen::Vector3d e(angle(rng), mid(rng), angle(rng));
+      Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+      for (int k = 0; k < 3; ++k) {
+        const int axis = static_cast<int>(order[k]) - 3;
+        q = q * Eigen::AngleAxisd(e[k] * M_PI / 180, Eigen::Vector3d::Unit(axis));
+      }
+      const Eigen::Vector3d back = EulerDegrees(q, order);
+      EXPECT_NEAR((back - e).norm(), 0, 1e-8);
+    }
+  }
+}
+
+TEST(BvhTest, BadInputNamesTheLine) {
+  const std::string good = kSmallBvh;
+  // A joint without a CHANNELS line (line 9 holds it).
+  EXPECT_EQ(LineOf(Replace(good, "\t\tCHANNELS 3 Zrotation Yrotation Xrotation\n", "")), 9);
+  // A frame with too few values (line 20 is the first frame).
+  EXPECT_EQ(LineOf(Replace(good, "1 2 3 0 0 0 90 0 0\n", "1 2 3 0 0 0 90 0\n")), 19);
+  EXPECT_EQ(LineOf(Replace(good, "1 2 3 90 0 0 0 0 0\n", "1 2 3 90 nan 0 0 0 0\n")), 20);
+  // An unknown rotation order: a repeated axis, or a channel that does not exist.
+  EXPECT_EQ(LineOf(Replace(good, "Zrotation Yrotation Xrotation", "Zrotation Zrotation Xrotation")), 9);
+  EXPECT_EQ(LineOf(Replace(good, "Zrotation Yrotation Xrotation", "Zrotation Wrotation Xrotation")), 9);
+  EXPECT_EQ(LineOf(Replace(good, "Frames:\t2", "Frames:\t3")), 20);
+}
+
+Avatar Person(const std::string& name) {
+  return LoadAvatar(fs::path(IRBENCH_SOURCE_DIR) / "avatars" / (name + ".json"));
+}
+
+TEST(BvhTest, ExportReimportRoundTrip) {
+  const Avatar avatar = Person("p2");
+  MotionContext ctx;
+  ctx.avatar = &avatar;
+  ctx.style = StyleFor("p2", 3);
+  const MotionPtr motion = BuildLibraryMotion("flap_both", nullptr, ctx);
+  const BvhFile out = MotionToBvh(*motion, avatar.skeleton, 30);
+  const std::string text = WriteBvh(out);
+  const BvhFile in = ParseBvh(text, "roundtrip.bvh");
+  ASSERT_EQ(in.frames.size(), out.frames.size());
+  ASSERT_EQ(in.channel_count, out.channel_count);
+  double worst_rad = 0, worst_m = 0;
+  for (size_t f = 0; f < in.frames.size(); ++f) {
+    for (const BvhJoint& j : in.joints) {
+      for (size_t k = 0; k < j.channels.size(); ++k) {
+        const double a = in.frames[f][j.first_channel + k], b = out.frames[f][j.first_channel + k];
+        if (j.channels[k] >= BvhChannel::kXrotation) {
+          worst_rad = std::max(worst_rad, std::abs(a - b) * M_PI / 180);
+        } else {
+          worst_m = std::max(worst_m, std::abs(a - b));
+        }
+      }
+    }
+  }
+  EXPECT_LT(worst_rad, 1e-4);
+  EXPECT_LT(worst_m, 1e-4);
+  // Re-imported and retargeted onto the same body, the joints come back.
+  MocapClip clip = BvhToClip(in);
+  clip.convention = DetectConvention(clip);
+  EXPECT_EQ(clip.convention, "irbench");
+  const auto back = Retarget(clip, avatar.skeleton);
+  double worst_joint = 0;
+  for (double t = 0; t < motion->Duration(); t += 0.2) {
+    const JointTransforms a = ForwardKinematics(avatar.skeleton, motion->At(t));
+    const JointTransforms b = ForwardKinematics(avatar.skeleton, back->At(t));
+    const auto ta = TruthJoints(avatar, a), tb = TruthJoints(avatar, b);
+    for (size_t j = 0; j < ta.size(); ++j) worst_joint = std::max(worst_joint, (ta[j] - tb[j]).norm());
+  }
+  EXPECT_LT(worst_joint, 0.002);
+
+  // assimp reads the exported file with every joint.
+  const fs::path file = fs::temp_directory_path() / "irbench_roundtrip_test.bvh";
+  std::ofstream(file) << text;
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(file.string(), 0);
+  ASSERT_NE(scene, nullptr) << importer.GetErrorString();
+  for (int j = 0; j < kJointCount; ++j) {
+    EXPECT_NE(scene->mRootNode->FindNode(JointName(j)), nullptr) << JointName(j);
+  }
+  ASSERT_EQ(scene->mNumAnimations, 1u);
+  EXPECT_EQ(scene->mAnimations[0]->mNumChannels, static_cast<unsigned>(kJointCount));
+  fs::remove(file);
+}
+
+// Every CMU clip beside the checkout: loads, retargets onto three persons, and
+// keeps the source's upper-arm and forearm directions.
+TEST(CmuClipsTest, RetargetKeepsArmDirections) {
+  const fs::path dir = fs::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "mocap" / "cmu";
+  if (!fs::is_directory(dir)) GTEST_SKIP() << "no CMU clips at " << dir;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".bvh") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 1u);
+  const Avatar persons[3] = {Person("p1"), Person("p2"), Person("p3")};
+  for (const fs::path& file : files) {
+    const MocapClip clip = LoadMocap(file);
+    EXPECT_FALSE(clip.convention.empty()) << file;
+    if (file.stem() == "16_01") {
+      EXPECT_NEAR(clip.frame_time, 1.0 / 120, 1e-9);
+    }
+    for (const Avatar& avatar : persons) {
+      const auto motion = Retarget(clip, avatar.skeleton);
+      double worst = 0;
+      const size_t step = std::max<size_t>(1, clip.frames.size() / 25);
+      for (size_t f = 0; f < clip.frames.size(); f += step) {
+        const JointTransforms fk = ForwardKinematics(avatar.skeleton, motion->At(f * clip.frame_time));
+        for (const char* side : {"right", "left"}) {
+          const std::string s = side;
+          const int sh = *JointFromName(s + "_shoulder");
+          for (int seg = 0; seg < 2; ++seg) {
+            const int a = motion->source_joint[sh + seg];
+            const int b = motion->source_joint[sh + seg + 1];
+            const Eigen::Vector3d src =
+                motion->world_from_source * (clip.frames[f].position[b] - clip.frames[f].position[a]);
+            const Eigen::Vector3d ours = fk[sh + seg + 1].translation() - fk[sh + seg].translation();
+            const double deg = std::acos(std::clamp(src.normalized().dot(ours.normalized()), -1.0, 1.0)) * 180 / M_PI;
+            worst = std::max(worst, deg);
+          }
+        }
+      }
+      EXPECT_LT(worst, 2.0) << file.filename() << " on " << avatar.params.name;
+      // The feet stay on the floor: the lowest ankle of the clip is at its bind height.
+      const JointTransforms fk0 = ForwardKinematics(avatar.skeleton, motion->At(0));
+      EXPECT_GT(fk0[kHead].translation().z(), 0.6 * avatar.params.height_m) << file.filename();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace irbench
