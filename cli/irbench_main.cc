@@ -9,6 +9,7 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "common/paths.h"
+#include "sim/sequence/motion_tools.h"
 #include "sim/sequence/render_bench.h"
 #include "sim/sequence/render_job.h"
 
@@ -26,7 +27,9 @@ void AddRenderInputOptions(CLI::App* cmd,
   cmd->add_option("--scene", o.scene, "scene name (scenes/) or file; default: the rig's scene");
   cmd->add_option("--rig", o.rig, "camera rig name (rigs/) or file")->capture_default_str();
   cmd->add_option("--avatar", o.avatar, "avatar name (avatars/) or file")->capture_default_str();
-  cmd->add_option("--motion", o.motion, "keyframe motion name (motions/) or file")
+  cmd->add_option("--motion", o.motion,
+                  "a library motion (irbench motion list), a file in motions/ (keyframes or session "
+                  "script), or a path to a .json, .bvh or .amc file")
       ->capture_default_str();
   cmd->add_option("--backend", backend, "OpenGL backend: auto, egl or osmesa")
       ->capture_default_str();
@@ -80,6 +83,27 @@ int main(int argc, char** argv) {
   render_cmd->add_flag("--force", render.overwrite, "replace an existing output folder");
   render_cmd->add_flag("--depth", render.write_depth, "also write camera depth as OpenEXR");
 
+  // motion
+  CLI::App* motion_cmd = app.add_subcommand("motion", "List, inspect and export motions");
+  motion_cmd->require_subcommand(1);
+  CLI::App* motion_list = motion_cmd->add_subcommand("list", "List the library motions and motions/ files");
+  std::string info_file;
+  CLI::App* motion_info = motion_cmd->add_subcommand(
+      "info", "Describe a BVH or AMC clip: convention, frames, frame time, the joint map");
+  motion_info->add_option("FILE", info_file, ".bvh or .amc file")->required();
+  irbench::MotionExportOptions export_options;
+  CLI::App* motion_export = motion_cmd->add_subcommand(
+      "export", "Write a motion, posed on an avatar, as BVH (Blender, assimp, MotionBuilder open it)");
+  motion_export->add_option("--motion", export_options.motion, "motion, as for render --motion")
+      ->required();
+  motion_export->add_option("--avatar", export_options.avatar, "avatar name or file")->capture_default_str();
+  motion_export->add_option("--scene", export_options.scene, "scene (for pointing targets)")
+      ->capture_default_str();
+  motion_export->add_option("--fps", export_options.fps, "frames per second")->capture_default_str();
+  motion_export->add_option("--seed", export_options.seed, "seed of the person's style")->capture_default_str();
+  motion_export->add_option("OUT", export_options.out, "output .bvh file")->required();
+  motion_export->add_flag("--force", export_options.overwrite, "replace an existing file");
+
   // bench
   CLI::App* bench_cmd = app.add_subcommand("bench", "Print throughput figures");
   bench_cmd->require_subcommand(1);
@@ -115,6 +139,18 @@ int main(int argc, char** argv) {
       ApplyShadows(render_shadows, render);
       const std::filesystem::path folder = irbench::RunRenderJob(render);
       std::cout << folder.string() << "\n";
+      return kExitOk;
+    }
+    if (motion_list->parsed()) {
+      std::cout << irbench::MotionListText();
+      return kExitOk;
+    }
+    if (motion_info->parsed()) {
+      std::cout << irbench::MotionInfoText(info_file);
+      return kExitOk;
+    }
+    if (motion_export->parsed()) {
+      std::cout << irbench::ExportMotion(export_options).string() << "\n";
       return kExitOk;
     }
     if (bench_render->parsed()) {

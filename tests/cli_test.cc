@@ -54,7 +54,8 @@ TEST(CliTest, HelpOnEveryCommand) {
   const fs::path dir = FreshTempDir("cli_help");
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"--help"}, {"render", "--help"}, {"bench", "--help"},
-        {"bench", "render", "--help"}}) {
+        {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
+        {"motion", "info", "--help"}, {"motion", "export", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
@@ -122,6 +123,74 @@ TEST(CliTest, BadInputGivesOneLineExitTwoAndNothingBehind) {
     }
     EXPECT_TRUE(Leftovers(dir).empty()) << c.name;
   }
+}
+
+// Bad motion files: one line naming the file and the line, exit code 2.
+TEST(CliTest, BadMotionFilesNameTheLine) {
+  const std::string good_bvh =
+      "HIERARCHY\nROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation "
+      "Xrotation Yrotation\n\tEnd Site\n\t{\n\t\tOFFSET 0 1 0\n\t}\n}\nMOTION\nFrames: 2\n"
+      "Frame Time: 0.1\n0 0 0 0 0 0\n0 0 0 0 0 0\n";
+  struct Case {
+    std::string name, file, text;
+    std::vector<std::string> message_has;
+  };
+  auto replace = [](std::string s, const std::string& a, const std::string& b) {
+    return s.replace(s.find(a), a.size(), b);
+  };
+  const std::vector<Case> cases = {
+      {"no_channels", "bad.bvh", replace(good_bvh, "\tCHANNELS 6 Xposition Yposition Zposition Zrotation "
+                                                   "Xrotation Yrotation\n", ""), {"bad.bvh", "line 5"}},
+      {"short_frame", "bad.bvh", replace(good_bvh, "0 0 0 0 0 0\n0", "0 0 0 0 0\n0"), {"bad.bvh", "line 14"}},
+      {"nan", "bad.bvh", replace(good_bvh, "0 0 0 0 0 0\n0 0 0 0 0 0", "0 0 0 0 0 0\n0 0 nan 0 0 0"),
+       {"bad.bvh", "line 15"}},
+      {"bad_order", "bad.bvh", replace(good_bvh, "Zrotation Xrotation", "Zrotation Zrotation"),
+       {"bad.bvh", "line 5"}},
+      {"no_arms", "bad.bvh", good_bvh, {"bad.bvh", "joints", "missing"}},
+      {"bad_target", "bad.json",
+       R"({"format": "irbench.session/1", "items": [{"motion": "point", "target": "moon"}]})",
+       {"bad.json", "items[0].target", "moon"}},
+      {"bad_library_name", "bad.json",
+       R"({"format": "irbench.session/1", "items": [{"motion": "moonwalk"}]})",
+       {"bad.json", "items[0]", "moonwalk"}},
+      // The AMC's last frame names a bone the ASF lacks: line 3 + 6 lines per frame x 2 + 1.
+      {"amc_unknown_bone", "07_01.amc", irbench::testing::CmuStyleAmc(2, "ltail 1 2 3\n"),
+       {"07_01.amc", "line 16", "ltail"}},
+  };
+  for (const Case& c : cases) {
+    const fs::path dir = FreshTempDir("cli_motion_" + c.name);
+    WriteText(dir / c.file, c.text);
+    if (c.file == "07_01.amc") WriteText(dir / "07.asf", irbench::testing::CmuStyleAsf());
+    const Result r = RunIrbench({"render", "--frames", "1", "--motion", (dir / c.file).string(), "--out",
+                                 (dir / "seq").string()},
+                                dir);
+    EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    for (const std::string& part : c.message_has) {
+      EXPECT_NE(r.err.find(part), std::string::npos) << c.name << ": '" << part << "' not in " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "seq")) << c.name;
+  }
+  const fs::path dir = FreshTempDir("cli_motion_name");
+  const Result r = RunIrbench({"render", "--motion", "moonwalk", "--out", (dir / "seq").string()}, dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("point_horizontal"), std::string::npos) << r.err;  // lists the library
+}
+
+TEST(CliTest, MotionExportWritesBvh) {
+  const fs::path dir = FreshTempDir("cli_motion_export");
+  const Result r = RunIrbench({"motion", "export", "--motion", "flap_one", "--avatar", "p2",
+                               (dir / "flap.bvh").string()},
+                              dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string bvh = ReadText(dir / "flap.bvh");
+  EXPECT_EQ(bvh.rfind("HIERARCHY\nROOT pelvis\n", 0), 0u);
+  EXPECT_EQ(RunIrbench({"motion", "export", "--motion", "flap_one", (dir / "flap.bvh").string()}, dir).exit_code,
+            2);  // exists
+  const Result list = RunIrbench({"motion", "list"}, dir);
+  EXPECT_EQ(list.exit_code, 0);
+  EXPECT_NE(list.out.find("direct_traffic"), std::string::npos);
+  EXPECT_NE(list.out.find("session_demo"), std::string::npos);
 }
 
 TEST(CliTest, RenderWritesTheSequenceAndPrintsWhere) {

@@ -1,6 +1,8 @@
 #pragma once
 // Helpers shared by the closed-loop tests.
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,6 +40,63 @@ inline std::string FastMotionJson() {
     {"t": 0.2, "root": [-0.3, -0.2, -0.15], "heading_deg": -60,
      "joints": {"right_shoulder": [0, 20, 100], "right_elbow": [0, 0, 60], "left_shoulder": [0, 60, 0],
                 "spine": [15, 0, 0], "right_knee": [-40, 0, 0], "left_hip": [30, 0, 0]}}]})";
+}
+
+// A CMU-style ASF skeleton (bone names as in the CMU database, y up, facing
+// +z, the subject's left at +x, inches x 0.45 units) and an AMC motion for it:
+// the left arm swings down and the right elbow bends over `frames` frames.
+inline std::string CmuStyleAsf() {
+  struct Bone {
+    const char* name;
+    double dx, dy, dz, length;
+  };
+  const Bone bones[] = {
+      {"lhipjoint", 1, -1, 0.3, 2.0}, {"lfemur", 0.1, -1, 0, 7.0},  {"ltibia", 0, -1, 0.05, 7.0},
+      {"lfoot", 0, -0.3, 1, 2.0},     {"rhipjoint", -1, -1, 0.3, 2.0}, {"rfemur", -0.1, -1, 0, 7.0},
+      {"rtibia", 0, -1, 0.05, 7.0},   {"rfoot", 0, -0.3, 1, 2.0},   {"lowerback", 0, 1, 0, 2.0},
+      {"upperback", 0, 1, 0, 2.0},    {"thorax", 0, 1, 0, 2.0},     {"lowerneck", 0, 1, 0, 1.5},
+      {"upperneck", 0, 1, 0, 1.5},    {"head", 0, 1, 0, 1.5},       {"lclavicle", 1, 0.3, 0, 3.0},
+      {"lhumerus", 1, 0, 0, 5.0},     {"lradius", 1, 0, 0, 4.0},    {"lwrist", 1, 0, 0, 1.5},
+      {"rclavicle", -1, 0.3, 0, 3.0}, {"rhumerus", -1, 0, 0, 5.0},  {"rradius", -1, 0, 0, 4.0},
+      {"rwrist", -1, 0, 0, 1.5}};
+  std::string asf =
+      "# CMU-style test skeleton\n:version 1.10\n:name test\n:units\n  mass 1.0\n  length 0.45\n"
+      "  angle deg\n:documentation\n  written by the tests\n:root\n  order TX TY TZ RX RY RZ\n"
+      "  axis XYZ\n  position 0 0 0\n  orientation 0 0 0\n:bonedata\n";
+  int id = 1;
+  for (const Bone& b : bones) {
+    const double n = std::sqrt(b.dx * b.dx + b.dy * b.dy + b.dz * b.dz);
+    char text[512];
+    std::snprintf(text, sizeof(text),
+                  "  begin\n    id %d\n    name %s\n    direction %.6f %.6f %.6f\n    length %.6f\n"
+                  "    axis 0 0 %d XYZ\n    dof rx ry rz\n    limits (-180 180)\n (-180 180)\n (-180 180)\n"
+                  "  end\n",
+                  id++, b.name, b.dx / n, b.dy / n, b.dz / n, b.length, (id % 3) * 15);
+    asf += text;
+  }
+  asf +=
+      ":hierarchy\n  begin\n    root lhipjoint rhipjoint lowerback\n    lhipjoint lfemur\n"
+      "    lfemur ltibia\n    ltibia lfoot\n    rhipjoint rfemur\n    rfemur rtibia\n    rtibia rfoot\n"
+      "    lowerback upperback\n    upperback thorax\n    thorax lowerneck lclavicle rclavicle\n"
+      "    lowerneck upperneck\n    upperneck head\n    lclavicle lhumerus\n    lhumerus lradius\n"
+      "    lradius lwrist\n    rclavicle rhumerus\n    rhumerus rradius\n    rradius rwrist\n  end\n";
+  return asf;
+}
+
+inline std::string CmuStyleAmc(int frames, const std::string& extra_bone_line = "") {
+  std::string amc = "# test motion\n:FULLY-SPECIFIED\n:DEGREES\n";
+  for (int f = 1; f <= frames; ++f) {
+    const double u = frames > 1 ? double(f - 1) / (frames - 1) : 0.0;
+    char text[512];
+    std::snprintf(text, sizeof(text),
+                  "%d\nroot %.4f 16.5 %.4f 0 %.4f 0\nlhumerus %.4f %.4f %.4f\nlradius 0 %.4f 0\n"
+                  "rradius %.4f 0 %.4f\nrhumerus 10 -20 %.4f\n",
+                  f, 2.0 * u, 1.0 * u, 20.0 * u, 15.0 * u, -25.0 * u, -70.0 * u, 60.0 * u, 30.0 * u,
+                  -50.0 * u, 35.0 * u);
+    amc += text;
+    if (f == frames) amc += extra_bone_line;
+  }
+  return amc;
 }
 
 }  // namespace irbench::testing

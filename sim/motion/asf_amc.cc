@@ -50,9 +50,15 @@ using Eigen::Vector3d;
 
 enum class Dof { kTx, kTy, kTz, kRx, kRy, kRz, kL };
 
-bool IsRotation(Dof d) { return d == Dof::kRx || d == Dof::kRy || d == Dof::kRz; }
-bool IsTranslation(Dof d) { return d == Dof::kTx || d == Dof::kTy || d == Dof::kTz; }
-int AxisOf(Dof d) { return static_cast<int>(d) % 3; }
+bool IsRotation(Dof d) {
+  return d == Dof::kRx || d == Dof::kRy || d == Dof::kRz;
+}
+bool IsTranslation(Dof d) {
+  return d == Dof::kTx || d == Dof::kTy || d == Dof::kTz;
+}
+int AxisOf(Dof d) {
+  return static_cast<int>(d) % 3;
+}
 
 std::string Lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -145,7 +151,7 @@ class LineReader {
 
 struct AsfBone {
   std::string name;
-  int line = 0;  // its `begin` line (0 for the root)
+  int line = 0;                           // its `begin` line (0 for the root)
   Vector3d direction = Vector3d::Zero();  // unit, world rest axes
   double length = 0;
   Matrix3d axis = Matrix3d::Identity();  // C: the bone's local axes in world axes
@@ -283,8 +289,8 @@ class AsfParser : public LineReader {
       for (size_t k = 1; k < line.tokens.size(); ++k) {
         const std::optional<Dof> d = ParseDof(line.tokens[k]);
         if (!d || *d == Dof::kL) {
-          Fail(line.number, "unknown root channel '" + line.tokens[k] +
-                                "' (expected TX TY TZ RX RY RZ)");
+          Fail(line.number,
+               "unknown root channel '" + line.tokens[k] + "' (expected TX TY TZ RX RY RZ)");
         }
         if (std::find(dofs.begin(), dofs.end(), *d) != dofs.end()) {
           Fail(line.number, "root channel '" + line.tokens[k] + "' repeated");
@@ -302,8 +308,8 @@ class AsfParser : public LineReader {
       ExpectValues(line, 3);
       for (int k = 0; k < 3; ++k) raw_axes_[0].angles[k] = Number(line, k + 1, "orientation");
     } else {
-      Fail(line.number, "unknown :root entry '" + key + "' (expected order, axis, position or "
-                        "orientation)");
+      Fail(line.number,
+           "unknown :root entry '" + key + "' (expected order, axis, position or orientation)");
     }
   }
 
@@ -439,8 +445,8 @@ class AsfParser : public LineReader {
 
   AsfSkeleton Finish() {
     if (bone_open_) {
-      Fail(line_count_, "the file ends inside the bone block begun at line " +
-                            std::to_string(bone_.line));
+      Fail(line_count_,
+           "the file ends inside the bone block begun at line " + std::to_string(bone_.line));
     }
     if (!seen_bonedata_) Fail(line_count_, "the file has no :bonedata section");
     if (hierarchy_ == Hierarchy::kAbsent) Fail(line_count_, "the file has no :hierarchy section");
@@ -552,7 +558,9 @@ using AmcFrames = std::vector<std::vector<std::vector<double>>>;
 
 class AmcParser : public LineReader {
  public:
-  AmcParser(const std::string& text, std::string file, const AsfSkeleton& skeleton,
+  AmcParser(const std::string& text,
+            std::string file,
+            const AsfSkeleton& skeleton,
             std::string asf_name)
       : LineReader(std::move(file)),
         lines_(SplitLines(text, &line_count_)),
@@ -581,14 +589,14 @@ class AmcParser : public LineReader {
       }
       if (std::all_of(key.begin(), key.end(), [](char c) { return c >= '0' && c <= '9'; })) {
         if (line.tokens.size() != 1) {
-          Fail(line.number, "a frame number line holds only the number, got '" + line.tokens[1] +
-                                "' after it");
+          Fail(line.number,
+               "a frame number line holds only the number, got '" + line.tokens[1] + "' after it");
         }
         if (key.size() > 12) Fail(line.number, "frame number '" + key + "' is too large");
         const long long number = std::stoll(key);
         if (!frames.empty() && number != last_number + 1) {
-          Fail(line.number, "frame " + key + " does not follow frame " +
-                                std::to_string(last_number));
+          Fail(line.number,
+               "frame " + key + " does not follow frame " + std::to_string(last_number));
         }
         last_number = number;
         frames.emplace_back(skeleton_.bones.size());
@@ -640,8 +648,10 @@ struct JointRef {
 };
 
 // Forward kinematics of one frame (see asf_amc.h for the convention).
-void Solve(const AsfSkeleton& skeleton, const std::vector<int>& bone_order,
-           const std::vector<JointRef>& joints, const std::vector<std::vector<double>>& values,
+void Solve(const AsfSkeleton& skeleton,
+           const std::vector<int>& bone_order,
+           const std::vector<JointRef>& joints,
+           const std::vector<std::vector<double>>& values,
            MocapClip::Frame* frame) {
   const size_t n = skeleton.bones.size();
   std::vector<Matrix3d> world(n);  // W_b: world delta rotation
@@ -684,8 +694,10 @@ void Solve(const AsfSkeleton& skeleton, const std::vector<int>& bone_order,
 
 }  // namespace
 
-MocapClip ParseAsfAmc(const std::string& asf_text, const std::string& asf_name,
-                      const std::string& amc_text, const std::string& amc_name,
+MocapClip ParseAsfAmc(const std::string& asf_text,
+                      const std::string& asf_name,
+                      const std::string& amc_text,
+                      const std::string& amc_name,
                       double frame_time) {
   if (!(frame_time > 0) || !std::isfinite(frame_time)) {
     throw InputError(amc_name, "frame_time", "frame time must be positive");
@@ -738,11 +750,13 @@ MocapClip ParseAsfAmc(const std::string& asf_text, const std::string& asf_name,
   return clip;
 }
 
-MocapClip LoadAsfAmc(const std::filesystem::path& asf, const std::filesystem::path& amc,
+MocapClip LoadAsfAmc(const std::filesystem::path& asf,
+                     const std::filesystem::path& amc,
                      double frame_time) {
   auto read = [](const std::filesystem::path& path, const char* what) {
     std::ifstream in(path, std::ios::binary);
-    if (!in || std::filesystem::is_directory(path)) throw InputError(path.string(), "file", std::string("cannot open the ") + what);
+    if (!in || std::filesystem::is_directory(path))
+      throw InputError(path.string(), "file", std::string("cannot open the ") + what);
     std::stringstream buffer;
     buffer << in.rdbuf();
     if (in.bad()) throw InputError(path.string(), "file", std::string("cannot read the ") + what);

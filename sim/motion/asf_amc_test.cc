@@ -137,8 +137,11 @@ Vector3d Position(const MocapClip& clip, int frame, const std::string& joint) {
 
 // Runs the parse expecting an InputError naming `file` and `field` whose
 // message contains `fragment`.
-void ExpectError(const std::string& asf, const std::string& amc, const std::string& file,
-                 int line, const std::string& fragment) {
+void ExpectError(const std::string& asf,
+                 const std::string& amc,
+                 const std::string& file,
+                 int line,
+                 const std::string& fragment) {
   try {
     Parse(asf, amc);
     ADD_FAILURE() << "no error; expected " << fragment;
@@ -151,8 +154,8 @@ void ExpectError(const std::string& asf, const std::string& amc, const std::stri
 
 TEST(AsfAmcTest, JointsNamesParentsAndMetadata) {
   const MocapClip clip = Parse();
-  const std::vector<std::string> names = {"root",      "lhumerus",      "lradius", "lradius_end",
-                                          "lowerback", "lowerback_end"};
+  const std::vector<std::string> names = {"root",        "lhumerus",  "lradius",
+                                          "lradius_end", "lowerback", "lowerback_end"};
   EXPECT_EQ(clip.joint_names, names);
   EXPECT_EQ(clip.parent, (std::vector<int>{-1, 0, 1, 2, 0, 4}));
   EXPECT_EQ(clip.name, "test_01");
@@ -233,8 +236,8 @@ TEST(AsfAmcTest, RootOrderAndRadians) {
   // The same frame 4 with the root's channels in another order and the AMC in
   // radians.
   const std::string asf = Replace(kAsf, "order TX TY TZ RX RY RZ", "order RZ RX RY TX TY TZ");
-  const std::string amc = "# r\n:FULLY-SPECIFIED\n:RADIANS\n1\nroot " +
-                          Fmt(std::numbers::pi / 2) + " 0 0 0.5 -1 2\n";
+  const std::string amc =
+      "# r\n:FULLY-SPECIFIED\n:RADIANS\n1\nroot " + Fmt(std::numbers::pi / 2) + " 0 0 0.5 -1 2\n";
   const MocapClip clip = Parse(asf, amc);
   const MocapClip reference = Parse();
   ASSERT_EQ(clip.frames.size(), 1u);
@@ -251,14 +254,14 @@ TEST(AsfAmcTest, GeneralAxisOrderAndDofOrder) {
   std::string asf = Replace(kAsf, "axis 0 0 90  XYZ", "axis 10 20 30 ZYX");
   asf = Replace(asf, "dof rx ry rz", "dof rz rx ry");
   const std::string amc = "1\nlhumerus 25 -40 70\n";
-  const Matrix3d c = (AngleAxisd(10 * kDeg, Vector3d::UnitX()) *
-                      AngleAxisd(20 * kDeg, Vector3d::UnitY()) *
-                      AngleAxisd(30 * kDeg, Vector3d::UnitZ()))
-                         .toRotationMatrix();
-  const Matrix3d m = (AngleAxisd(70 * kDeg, Vector3d::UnitY()) *
-                      AngleAxisd(-40 * kDeg, Vector3d::UnitX()) *
-                      AngleAxisd(25 * kDeg, Vector3d::UnitZ()))
-                         .toRotationMatrix();
+  const Matrix3d c =
+      (AngleAxisd(10 * kDeg, Vector3d::UnitX()) * AngleAxisd(20 * kDeg, Vector3d::UnitY()) *
+       AngleAxisd(30 * kDeg, Vector3d::UnitZ()))
+          .toRotationMatrix();
+  const Matrix3d m =
+      (AngleAxisd(70 * kDeg, Vector3d::UnitY()) * AngleAxisd(-40 * kDeg, Vector3d::UnitX()) *
+       AngleAxisd(25 * kDeg, Vector3d::UnitZ()))
+          .toRotationMatrix();
   const Matrix3d w = c * m * c.transpose();
   const MocapClip clip = Parse(asf, amc);
   const Vector3d root(1, 2, 3);
@@ -392,8 +395,9 @@ TEST(AsfAmcTest, AsfErrorsNameTheLine) {
 TEST(AsfAmcTest, TranslationAndLengthDofs) {
   // `tx` moves the bone's start along its local x (world y for lhumerus) before
   // its rotation, as in the CMU viewer; `l` adds to the length.
-  const std::string asf = Replace(kAsf, "dof rx ry rz\n     limits (-90.0 90.0)\n"
-                                        "            (-90.0 90.0)\n            (-inf inf)\n",
+  const std::string asf = Replace(kAsf,
+                                  "dof rx ry rz\n     limits (-90.0 90.0)\n"
+                                  "            (-90.0 90.0)\n            (-inf inf)\n",
                                   "dof tx rz l\n");
   const MocapClip clip = Parse(asf, "1\nlhumerus 2 90 1\n");
   const Vector3d root(1, 2, 3);

@@ -33,7 +33,7 @@ TEST(KeyframesTest, InterpolatesAndHolds) {
 }
 
 TEST(KeyframesTest, ShippedMotionsLoad) {
-  for (const char* name : {"wave", "stand", "point", "enter_wave_leave"}) {
+  for (const char* name : {"wave", "stand", "point_keys", "enter_wave_leave"}) {
     const auto motion =
         LoadKeyframes(std::string(IRBENCH_SOURCE_DIR) + "/motions/" + name + ".json");
     EXPECT_GT(motion.Duration(), 1.0) << name;

@@ -5,7 +5,7 @@
 
 #include "common/error.h"
 #include "common/logging.h"
-//ASF #include "sim/motion/asf_amc.h"
+#include "sim/motion/asf_amc.h"
 #include "sim/motion/bvh.h"
 
 namespace irbench {
@@ -139,7 +139,7 @@ MocapClip LoadMocap(const std::filesystem::path& path, const std::filesystem::pa
                                                     by_subject.string() + "' and '" + by_stem.string() + "')");
       }
     }
-    throw InputError(path.string(), "file", "ASF/AMC pending"); //ASF
+    clip = LoadAsfAmc(skeleton, path);
   } else {
     throw InputError(path.string(), "file", "unknown motion-capture format '" + ext + "' (.bvh or .amc)");
   }

@@ -1,0 +1,173 @@
+// Motion capture and the motion library through the renderer: every CMU clip
+// beside the checkout retargets onto a person and renders with its visible
+// truth joints on the person's mask; a session's truth carries labels,
+// pointing and events.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sim/motion/retarget.h"
+#include "sim/sequence/render_job.h"
+#include "tests/test_util.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+using irbench::testing::FreshTempDir;
+using irbench::testing::ReadText;
+using irbench::testing::WriteText;
+
+// Largest distance (px) of a visible truth joint from the mask, over the
+// sequence; counts the visible joints checked.
+double WorstVisibleJointOffMask(const fs::path& seq, int* visible) {
+  const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+  std::ifstream truth(seq / "truth/frames.jsonl");
+  std::string line;
+  double worst = 0;
+  while (std::getline(truth, line)) {
+    const auto frame = nlohmann::json::parse(line);
+    char file[32];
+    std::snprintf(file, sizeof(file), "%06d.png", frame["frame"].get<int>());
+    for (const auto& cam : manifest["cameras"]) {
+      const cv::Mat mask = cv::imread((seq / "truth/masks" / cam.get<std::string>() / file).string(),
+                                      cv::IMREAD_UNCHANGED);
+      if (mask.empty()) return 1e9;
+      cv::Mat distance;
+      cv::distanceTransform(255 - mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+      for (const auto& [joint, uvv] : frame["joints2d"][cam.get<std::string>()].items()) {
+        if (uvv[2] != 2 || joint == "root") continue;
+        const int u = int(std::lround(double(uvv[0]))), v = int(std::lround(double(uvv[1])));
+        if (u < 0 || v < 0 || u >= mask.cols || v >= mask.rows) return 1e9;
+        worst = std::max(worst, double(distance.at<float>(v, u)));
+        ++*visible;
+      }
+    }
+  }
+  return worst;
+}
+
+TEST(MotionRenderTest, EveryCmuClipRetargetsAndRenders) {
+  const fs::path clips = fs::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "mocap" / "cmu";
+  if (!fs::is_directory(clips)) GTEST_SKIP() << "no CMU clips at " << clips;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(clips)) {
+    if (e.path().extension() == ".bvh") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  const fs::path dir = FreshTempDir("motion_cmu");
+  int index = 0;
+  for (const fs::path& clip : files) {
+    // Two frames from the middle of the clip, on persons p1, p2, p3 in turn,
+    // through a session script (which trims the clip).
+    const fs::path session = dir / (clip.stem().string() + ".json");
+    WriteText(session, nlohmann::json{{"format", "irbench.session/1"},
+                                      {"items", {{{"clip", clip.string()}, {"start_s", 1.0}}}}}
+                           .dump());
+    RenderJobOptions options;
+    options.rig = "lab4";
+    options.avatar = "p" + std::to_string(1 + index++ % 3);
+    options.motion = session.string();
+    options.frames = 2;
+    options.background_frames = 0;
+    options.out = dir / clip.stem();
+    const fs::path seq = RunRenderJob(options);
+    int visible = 0;
+    const double worst = WorstVisibleJointOffMask(seq, &visible);
+    EXPECT_GT(visible, 10) << clip.filename();
+    EXPECT_LE(worst, 2.0) << clip.filename() << " on " << options.avatar;
+    const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+    EXPECT_EQ(manifest["motion"]["kind"], "session");
+    fs::remove_all(seq);
+  }
+}
+
+// An ASF/AMC pair (CMU bone names) loads, retargets keeping the arm
+// directions, and renders.
+TEST(MotionRenderTest, AsfAmcRetargetsAndRenders) {
+  const fs::path dir = FreshTempDir("motion_amc");
+  WriteText(dir / "07.asf", irbench::testing::CmuStyleAsf());
+  WriteText(dir / "07_05.amc", irbench::testing::CmuStyleAmc(30));
+  const MocapClip clip = LoadMocap(dir / "07_05.amc");
+  EXPECT_EQ(clip.convention, "cmu");
+  EXPECT_EQ(clip.frames.size(), 30u);
+  EXPECT_NEAR(clip.frame_time, 1.0 / 120, 1e-12);
+  for (const char* person : {"p1", "p4"}) {
+    const Avatar avatar = LoadAvatar(fs::path(IRBENCH_SOURCE_DIR) / "avatars" / (std::string(person) + ".json"));
+    const auto motion = Retarget(clip, avatar.skeleton);
+    double worst = 0;
+    for (size_t f = 0; f < clip.frames.size(); f += 3) {
+      const JointTransforms fk = ForwardKinematics(avatar.skeleton, motion->At(f * clip.frame_time));
+      for (int sh : {kRightShoulder, kLeftShoulder}) {
+        for (int seg = 0; seg < 2; ++seg) {
+          const Eigen::Vector3d src = motion->world_from_source *
+                                      (clip.frames[f].position[motion->source_joint[sh + seg + 1]] -
+                                       clip.frames[f].position[motion->source_joint[sh + seg]]);
+          const Eigen::Vector3d ours = fk[sh + seg + 1].translation() - fk[sh + seg].translation();
+          worst = std::max(worst, std::acos(std::clamp(src.normalized().dot(ours.normalized()), -1.0, 1.0)));
+        }
+      }
+    }
+    EXPECT_LT(worst * 180 / M_PI, 2.0) << person;
+  }
+  RenderJobOptions options;
+  options.rig = "lab4";
+  options.motion = (dir / "07_05.amc").string();
+  options.frames = 3;
+  options.background_frames = 0;
+  options.out = dir / "seq";
+  const fs::path seq = RunRenderJob(options);
+  int visible = 0;
+  EXPECT_LE(WorstVisibleJointOffMask(seq, &visible), 2.0);
+  EXPECT_GT(visible, 10);
+  const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+  EXPECT_EQ(manifest["motion"]["kind"], "amc");
+}
+
+TEST(MotionRenderTest, SessionTruthCarriesLabelsPointingAndEvents) {
+  const fs::path dir = FreshTempDir("motion_session");
+  const fs::path session = dir / "s.json";
+  WriteText(session, R"({"format": "irbench.session/1", "crossfade_s": 0.2, "items": [
+    {"motion": "point", "target": "helicopter", "side": "right", "hold_s": 0.5},
+    {"motion": "raise_overhead", "side": "left", "hold_s": 0.3}]})");
+  RenderJobOptions options;
+  options.rig = "lab4";
+  options.scene = "theater";
+  options.motion = session.string();
+  options.background_frames = 0;
+  options.out = dir / "seq";
+  const fs::path seq = RunRenderJob(options);
+  const auto events = nlohmann::json::parse(ReadText(seq / "truth/events.json"));
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0]["kind"], "point");
+  EXPECT_EQ(events[0]["value"], "helicopter");
+  EXPECT_EQ(events[1]["value"], "raise_overhead");
+  std::ifstream truth(seq / "truth/frames.jsonl");
+  std::string line;
+  int pointing = 0, gesture = 0, frames = 0, left_up = 0;
+  while (std::getline(truth, line)) {
+    const auto f = nlohmann::json::parse(line);
+    ++frames;
+    const int n = f["frame"];
+    if (n >= events[0]["start_frame"].get<int>() && n <= events[0]["end_frame"].get<int>()) {
+      EXPECT_EQ(f["pointing"]["right"]["aimed_at"], "helicopter") << n;
+      EXPECT_EQ(f["pointing"]["right"]["target"], "helicopter") << n;
+      ++pointing;
+    }
+    gesture += f["labels"]["gesture"] == "raise_overhead";
+    left_up += f["labels"]["posture"][0] == "A2" && f["labels"]["rest"]["right"] == true;
+  }
+  EXPECT_GT(pointing, 5);
+  EXPECT_GE(gesture, events[1]["end_frame"].get<int>() - events[1]["start_frame"].get<int>());
+  EXPECT_GT(left_up, 3);
+  // The BVH export of the rendered motion has one frame per rendered frame.
+  const std::string bvh = ReadText(seq / "truth/motion.bvh");
+  EXPECT_NE(bvh.find("Frames: " + std::to_string(frames) + "\n"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace irbench
