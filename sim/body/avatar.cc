@@ -307,12 +307,16 @@ Avatar BuildTubeAvatar(const AvatarParams& params) {
 
 Avatar LoadAvatar(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
-  root.CheckKeys({"format", "name", "description", "kind", "height_m", "build", "albedo"});
+  root.CheckKeys({"format", "name", "description", "kind", "height_m", "build", "albedo", "style"});
   if (root.GetString("format") != "irbench.avatar/1") root["format"].Fail("expected \"irbench.avatar/1\"");
   const std::string kind = root.GetString("kind");
   if (kind != "tube") root["kind"].Fail("unknown avatar kind '" + kind + "' (tube)");
   AvatarParams params;
   params.name = root.GetString("name", path.stem().string());
+  if (root.Has("style")) {
+    if (!root["style"].raw().is_object()) root["style"].Fail("must be an object (see docs/motion.md)");
+    params.style = root["style"].raw();
+  }
   params.height_m = root.GetDouble("height_m");
   if (params.height_m < 1.0 || params.height_m > 2.3) root["height_m"].Fail("must be in 1.0..2.3 m");
   params.build = root.GetDouble("build", 1.0);

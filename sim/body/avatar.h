@@ -8,6 +8,7 @@
 #include <array>
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct AvatarParams {
   float pants_albedo = 0.35f;
   float shoe_albedo = 0.15f;
   float hair_albedo = 0.25f;
+  // How this person moves: fields of MotionStyle (docs/motion.md) that
+  // override the seeded draw; checked by the motion library.
+  nlohmann::json style = nullptr;
 };
 
 struct Avatar {

@@ -691,7 +691,8 @@ std::vector<std::pair<std::string, std::string>> LibraryMotions() {
   };
 }
 
-MotionStyle StyleFor(const std::string& person, uint64_t seed, const nlohmann::json& overrides) {
+MotionStyle StyleFor(const std::string& person, uint64_t seed, const nlohmann::json& overrides,
+                     const std::string& file) {
   MotionStyle st;
   uint64_t state = Fnv1a64(person) ^ (seed * 0x9E3779B97F4A7C15ull);
   st.seed = state;
@@ -702,16 +703,41 @@ MotionStyle StyleFor(const std::string& person, uint64_t seed, const nlohmann::j
   st.tremor_hz = 8.0 + 4.0 * Uniform(state);
   st.handedness = Uniform(state) < 0.2 ? -1 : 1;
   st.rest_abduction_deg = 5 + 8 * Uniform(state);
-  if (overrides.is_object()) {
-    for (const auto& [key, value] : overrides.items()) {
-      if (key == "tempo") st.tempo = value.get<double>();
-      else if (key == "amplitude") st.amplitude = value.get<double>();
-      else if (key == "asynchrony_s") st.asynchrony_s = value.get<double>();
-      else if (key == "tremor_deg") st.tremor_deg = value.get<double>();
-      else if (key == "tremor_hz") st.tremor_hz = value.get<double>();
-      else if (key == "handedness") st.handedness = value.get<std::string>() == "left" ? -1 : 1;
-      else if (key == "rest_abduction_deg") st.rest_abduction_deg = value.get<double>();
+  if (overrides.is_null()) return st;
+  if (!overrides.is_object()) throw InputError(file, "style", "must be an object");
+  for (const auto& [key, value] : overrides.items()) {
+    const std::string field = "style." + key;
+    if (key == "handedness") {
+      if (!value.is_string() || (value != "left" && value != "right")) {
+        throw InputError(file, field, "must be \"left\" or \"right\"");
+      }
+      st.handedness = value == "left" ? -1 : 1;
+      continue;
     }
+    struct Knob {
+      const char* name;
+      double* target;
+      double lo, hi;
+    };
+    const Knob knobs[] = {{"tempo", &st.tempo, 0.3, 3.0},
+                          {"amplitude", &st.amplitude, 0.3, 1.5},
+                          {"asynchrony_s", &st.asynchrony_s, 0.0, 1.0},
+                          {"tremor_deg", &st.tremor_deg, 0.0, 5.0},
+                          {"tremor_hz", &st.tremor_hz, 1.0, 30.0},
+                          {"rest_abduction_deg", &st.rest_abduction_deg, 0.0, 30.0}};
+    const Knob* knob = nullptr;
+    for (const Knob& k : knobs) {
+      if (key == k.name) knob = &k;
+    }
+    if (!knob) {
+      throw InputError(file, field, "unknown style field (tempo, amplitude, asynchrony_s, tremor_deg, "
+                                    "tremor_hz, handedness, rest_abduction_deg)");
+    }
+    if (!value.is_number() || value.get<double>() < knob->lo || value.get<double>() > knob->hi) {
+      throw InputError(file, field, "must be a number in " + std::to_string(knob->lo) + ".." +
+                                        std::to_string(knob->hi));
+    }
+    *knob->target = value.get<double>();
   }
   return st;
 }

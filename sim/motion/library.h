@@ -31,8 +31,10 @@ struct MotionStyle {
 
 // The style of a named person: drawn from a hash of the name and the seed, so
 // it is the same on every machine. `overrides` (an avatar file's "style"
-// object; null for none) sets fields by name.
-MotionStyle StyleFor(const std::string& person, uint64_t seed, const nlohmann::json& overrides = nullptr);
+// object; null for none) sets fields by name; bad ones are InputErrors naming
+// `file` and "style.<field>".
+MotionStyle StyleFor(const std::string& person, uint64_t seed, const nlohmann::json& overrides = nullptr,
+                     const std::string& file = "");
 
 // Where the person is when a motion starts, updated to where it ends.
 struct StageState {

@@ -181,6 +181,22 @@ TEST(LibraryTest, EveryMotionBuildsAndKeepsFeetOnTheFloor) {
   EXPECT_NEAR((ctx.state.position - Eigen::Vector2d(1.0, 0.5)).norm(), 0, 1e-12);
 }
 
+TEST(LibraryTest, StyleOverridesAreCheckedAndApplied) {
+  const MotionStyle st = StyleFor("p1", 1, {{"tempo", 1.5}, {"handedness", "left"}}, "avatars/x.json");
+  EXPECT_EQ(st.tempo, 1.5);
+  EXPECT_EQ(st.handedness, -1);
+  EXPECT_EQ(st.amplitude, StyleFor("p1", 1).amplitude);
+  try {
+    StyleFor("p1", 1, {{"tempo", 9.0}}, "avatars/x.json");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "avatars/x.json");
+    EXPECT_EQ(e.field(), "style.tempo");
+  }
+  EXPECT_THROW(StyleFor("p1", 1, {{"speed", 1.0}}, "x"), InputError);
+  EXPECT_THROW(StyleFor("p1", 1, {{"handedness", "both"}}, "x"), InputError);
+}
+
 TEST(LibraryTest, BadNamesAndParametersAreInputErrors) {
   const Avatar avatar = Person("p1");
   MotionContext ctx{&avatar, &Theater(), StyleFor("p1", 1), {}};

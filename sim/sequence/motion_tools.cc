@@ -72,12 +72,13 @@ fs::path ExportMotion(const MotionExportOptions& options) {
   if (fs::exists(options.out) && !options.overwrite) {
     throw InputError("", "OUT", "'" + options.out.string() + "' exists (pass --force to replace it)");
   }
-  const Avatar avatar = LoadAvatar(ResolveDataFile("avatars", options.avatar, "--avatar"));
+  const fs::path avatar_file = ResolveDataFile("avatars", options.avatar, "--avatar");
+  const Avatar avatar = LoadAvatar(avatar_file);
   const Scene scene = LoadScene(ResolveDataFile("scenes", options.scene, "--scene"));
   MotionContext ctx;
   ctx.avatar = &avatar;
   ctx.scene = &scene;
-  ctx.style = StyleFor(avatar.params.name, options.seed);
+  ctx.style = StyleFor(avatar.params.name, options.seed, avatar.params.style, avatar_file.string());
   const ResolvedMotion motion = ResolveMotion(options.motion, ctx, "--motion");
   AtomicWriteFile(options.out, WriteBvh(MotionToBvh(*motion.motion, avatar.skeleton, options.fps)));
   return options.out;

@@ -67,7 +67,7 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   MotionContext ctx;
   ctx.avatar = &in.avatar;
   ctx.scene = &in.scene;
-  ctx.style = StyleFor(in.avatar.params.name, options.seed);
+  ctx.style = StyleFor(in.avatar.params.name, options.seed, in.avatar.params.style, in.avatar_file.string());
   in.style = ctx.style;
   const ResolvedMotion resolved = ResolveMotion(options.motion, ctx, "--motion");
   in.motion = resolved.motion;
