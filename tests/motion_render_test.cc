@@ -52,13 +52,8 @@ double WorstVisibleJointOffMask(const fs::path& seq, int* visible) {
 }
 
 TEST(MotionRenderTest, EveryCmuClipRetargetsAndRenders) {
-  const fs::path clips = fs::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "mocap" / "cmu";
-  if (!fs::is_directory(clips)) GTEST_SKIP() << "no CMU clips at " << clips;
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(clips)) {
-    if (e.path().extension() == ".bvh") files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = irbench::testing::CmuClips();
+  if (files.empty()) GTEST_SKIP() << "no CMU clips in ../shared/data/mocap/cmu";
   const fs::path dir = FreshTempDir("motion_cmu");
   for (const fs::path& clip : files) {
     // Two frames from the middle of the clip through a session script (which

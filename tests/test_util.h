@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <algorithm>
 #include <string>
+#include <vector>
 
 namespace irbench::testing {
 
@@ -27,6 +29,19 @@ inline std::string ReadText(const std::filesystem::path& path) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   return buffer.str();
+}
+
+// The CMU development clips beside the checkout (../shared/data/mocap/cmu),
+// sorted; empty when the folder is absent (tests then skip).
+inline std::vector<std::filesystem::path> CmuClips() {
+  const auto dir = std::filesystem::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "mocap" / "cmu";
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    if (e.path().extension() == ".bvh") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 // A short motion with wide arm and body movement, so a few frames cover
