@@ -12,7 +12,7 @@ PACKAGES=(
   libopenexr-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libassimp-dev
+  libassimp-dev libtinygltf-dev
 )
 
 missing=()

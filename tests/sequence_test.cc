@@ -152,12 +152,14 @@ TEST(SequenceDepthTest, ExrDepthAgreesWithTruthJoints) {
         if (int(uvv[2]) != 2 || joint == "root") continue;
         const auto& p = frame["joints3d"][joint];
         const cv::Mat p_in_cam = rot * (cv::Mat_<double>(3, 1) << p[0], p[1], p[2]) + tvec;
-        // Within one pixel of the joint, some surface seen lies in front of it
-        // by less than a body radius (the visibility rule, docs/truth.md).
+        // Near the joint, some surface seen lies in front of it by less than a
+        // body radius (the visibility rule, docs/truth.md, looks within one
+        // pixel in the supersampled render; the EXR holds one nearest sample
+        // per pixel, which can fall beside a thin limb, hence two pixels here).
         const int u = int(std::lround(double(uvv[0]))), v = int(std::lround(double(uvv[1])));
         bool found = false;
-        for (int dv = -1; dv <= 1; ++dv) {
-          for (int du = -1; du <= 1; ++du) {
+        for (int dv = -2; dv <= 2; ++dv) {
+          for (int du = -2; du <= 2; ++du) {
             if (u + du < 0 || v + dv < 0 || u + du >= depth.cols || v + dv >= depth.rows) continue;
             const double in_front = p_in_cam.at<double>(2) - depth.at<float>(v + dv, u + du);
             found = found || (in_front > -0.05 && in_front < 0.2);

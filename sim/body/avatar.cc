@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "common/json_reader.h"
+#include "sim/body/parametric.h"
 
 namespace irbench {
 namespace {
@@ -307,11 +308,12 @@ Avatar BuildTubeAvatar(const AvatarParams& params) {
 
 Avatar LoadAvatar(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
-  root.CheckKeys({"format", "name", "description", "kind", "height_m", "build", "albedo", "style"});
+  root.CheckKeys({"format", "name", "description", "kind", "height_m", "build", "albedo", "style", "shape"});
   if (root.GetString("format") != "irbench.avatar/1") root["format"].Fail("expected \"irbench.avatar/1\"");
   const std::string kind = root.GetString("kind");
-  if (kind != "tube") root["kind"].Fail("unknown avatar kind '" + kind + "' (tube)");
+  if (kind != "tube" && kind != "parametric") root["kind"].Fail("unknown avatar kind '" + kind + "' (tube, parametric)");
   AvatarParams params;
+  params.kind = kind;
   params.name = root.GetString("name", path.stem().string());
   if (root.Has("style")) {
     if (!root["style"].raw().is_object()) root["style"].Fail("must be an object (see docs/motion.md)");
@@ -336,7 +338,31 @@ Avatar LoadAvatar(const std::filesystem::path& path) {
     read("shoes", params.shoe_albedo);
     read("hair", params.hair_albedo);
   }
-  return BuildTubeAvatar(params);
+  if (kind == "tube") {
+    if (root.Has("shape")) root["shape"].Fail("only parametric avatars have a shape");
+    return BuildTubeAvatar(params);
+  }
+  BodyShape shape;
+  if (root.Has("shape")) {
+    const JsonNode s = root["shape"];
+    s.CheckKeys({"shoulder_width", "hip_width", "arm_length", "leg_length", "head_size", "belly", "clothing"});
+    auto ratio = [&](const char* key, double& out, double lo, double hi) {
+      if (!s.Has(key)) return;
+      out = s.GetDouble(key);
+      if (out < lo || out > hi) s[key].Fail("must be in " + std::to_string(lo).substr(0, 4) + ".." + std::to_string(hi).substr(0, 4));
+    };
+    ratio("shoulder_width", shape.shoulder_width, 0.8, 1.25);
+    ratio("hip_width", shape.hip_width, 0.8, 1.3);
+    ratio("arm_length", shape.arm_length, 0.85, 1.15);
+    ratio("leg_length", shape.leg_length, 0.85, 1.15);
+    ratio("head_size", shape.head_size, 0.85, 1.15);
+    ratio("belly", shape.belly, 0.0, 1.0);
+    shape.clothing = s.GetString("clothing", "tight");
+    if (shape.clothing != "tight" && shape.clothing != "loose_shirt" && shape.clothing != "jacket") {
+      s["clothing"].Fail("must be tight, loose_shirt or jacket");
+    }
+  }
+  return BuildParametricAvatar(params, shape);
 }
 
 void SkinVertices(const Avatar& avatar,

@@ -19,6 +19,7 @@ namespace irbench {
 
 struct AvatarParams {
   std::string name = "p1";
+  std::string kind = "tube";  // tube, parametric, mesh (imported)
   double height_m = 1.75;
   double build = 1.0;  // girth factor: 0.8 slim .. 1.4 heavy
   float skin_albedo = 0.55f;

@@ -629,8 +629,10 @@ Visibility Renderer::PointVisibility(int index,
   const double qx = rc.fx * p_in_cam.x() / p_in_cam.z() + rc.cx;
   const double qy = rc.fy * p_in_cam.y() / p_in_cam.z() + rc.cy;
   const int ix = static_cast<int>(std::lround(qx)), iy = static_cast<int>(std::lround(qy));
-  // Seen if any pinhole pixel within one output pixel shows a surface close
-  // enough in front of the point (and it is the person, when required).
+  // Seen if any pinhole pixel within one output pixel shows a surface within
+  // the tolerance of the point's depth — close enough in front of it, and not
+  // far behind it (that pixel sees past the body) — and it is the person, when
+  // required.
   const int r = options_.supersample;
   for (int dy = -r; dy <= r; ++dy) {
     for (int dx = -r; dx <= r; ++dx) {
@@ -639,7 +641,7 @@ Visibility Renderer::PointVisibility(int index,
       if (require_person && t.raw_mask.at<uint8_t>(y, x) < 128) continue;
       const float seen_depth = t.raw_depth.at<float>(y, x);
       if (seen_depth <= 0) continue;
-      if (seen_depth >= p_in_cam.z() - tolerance_m) return kVisible;
+      if (std::abs(seen_depth - p_in_cam.z()) <= tolerance_m) return kVisible;
     }
   }
   return kOccluded;
