@@ -9,6 +9,7 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "common/paths.h"
+#include "sim/sequence/avatar_tools.h"
 #include "sim/sequence/motion_tools.h"
 #include "sim/sequence/render_bench.h"
 #include "sim/sequence/render_job.h"
@@ -104,6 +105,22 @@ int main(int argc, char** argv) {
   motion_export->add_option("OUT", export_options.out, "output .bvh file")->required();
   motion_export->add_flag("--force", export_options.overwrite, "replace an existing file");
 
+  // avatar
+  CLI::App* avatar_cmd = app.add_subcommand("avatar", "List, inspect and export avatars");
+  avatar_cmd->require_subcommand(1);
+  CLI::App* avatar_list = avatar_cmd->add_subcommand("list", "List the avatars in avatars/");
+  std::string avatar_name;
+  CLI::App* avatar_info = avatar_cmd->add_subcommand("info", "Height, triangles and closedness of an avatar");
+  avatar_info->add_option("AVATAR", avatar_name, "avatar name (avatars/) or file")->required();
+  std::string avatar_export_name;
+  std::filesystem::path avatar_out;
+  bool avatar_force = false;
+  CLI::App* avatar_export = avatar_cmd->add_subcommand(
+      "export", "Write an avatar as binary glTF (.glb): mesh, skeleton and skin, for Blender or any viewer");
+  avatar_export->add_option("AVATAR", avatar_export_name, "avatar name (avatars/) or file")->required();
+  avatar_export->add_option("OUT", avatar_out, "output .glb file")->required();
+  avatar_export->add_flag("--force", avatar_force, "replace an existing file");
+
   // bench
   CLI::App* bench_cmd = app.add_subcommand("bench", "Print throughput figures");
   bench_cmd->require_subcommand(1);
@@ -139,6 +156,18 @@ int main(int argc, char** argv) {
       ApplyShadows(render_shadows, render);
       const std::filesystem::path folder = irbench::RunRenderJob(render);
       std::cout << folder.string() << "\n";
+      return kExitOk;
+    }
+    if (avatar_list->parsed()) {
+      std::cout << irbench::AvatarListText();
+      return kExitOk;
+    }
+    if (avatar_info->parsed()) {
+      std::cout << irbench::AvatarInfoText(avatar_name);
+      return kExitOk;
+    }
+    if (avatar_export->parsed()) {
+      std::cout << irbench::ExportAvatar(avatar_export_name, avatar_out, avatar_force).string() << "\n";
       return kExitOk;
     }
     if (motion_list->parsed()) {

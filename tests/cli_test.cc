@@ -55,7 +55,8 @@ TEST(CliTest, HelpOnEveryCommand) {
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"--help"}, {"render", "--help"}, {"bench", "--help"},
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
-        {"motion", "info", "--help"}, {"motion", "export", "--help"}}) {
+        {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
+        {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
@@ -175,6 +176,29 @@ TEST(CliTest, BadMotionFilesNameTheLine) {
   const Result r = RunIrbench({"render", "--motion", "moonwalk", "--out", (dir / "seq").string()}, dir);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("point_horizontal"), std::string::npos) << r.err;  // lists the library
+}
+
+TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
+  const fs::path dir = FreshTempDir("cli_avatar");
+  const Result r = RunIrbench({"avatar", "export", "p2", (dir / "p2.glb").string()}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(ReadText(dir / "p2.glb").substr(0, 4), "glTF");
+  const Result info = RunIrbench({"avatar", "info", "p2"}, dir);
+  EXPECT_EQ(info.exit_code, 0);
+  EXPECT_NE(info.out.find("watertight  yes"), std::string::npos) << info.out;
+  // A height outside 1.0-2.3 m: one line naming the file and field, exit 2.
+  WriteText(dir / "tall.json", R"({"format": "irbench.avatar/1", "kind": "parametric", "height_m": 2.6})");
+  for (const auto& args : {std::vector<std::string>{"avatar", "export", (dir / "tall.json").string(),
+                                                    (dir / "tall.glb").string()},
+                           std::vector<std::string>{"render", "--frames", "1", "--avatar", (dir / "tall.json").string(),
+                                                    "--out", (dir / "seq").string()}}) {
+    const Result bad = RunIrbench(args, dir);
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+    EXPECT_NE(bad.err.find("tall.json: height_m"), std::string::npos) << bad.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "tall.glb"));
+  EXPECT_FALSE(fs::exists(dir / "seq"));
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
 namespace irbench {
@@ -137,6 +139,38 @@ TEST(ParametricTest, ArmVolumeKeptUnderFlexionAndAbduction) {
       std::printf("h %.2f %s: arm region %.2f l, posed/rest %.3f\n", person.height, c.name, rest * 1000, v / rest);
     }
   }
+}
+
+// Every person shipped in avatars/: closed, and as tall as its parameter.
+TEST(ParametricTest, ShippedPersonsAreWatertightAndTheirHeight) {
+  int persons = 0, loose = 0;
+  double lowest = 1e9, highest = 0, slimmest = 1e9, heaviest = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(IRBENCH_SOURCE_DIR) + "/avatars")) {
+    const Avatar a = LoadAvatar(e.path());
+    if (a.params.kind != "parametric") continue;
+    ++persons;
+    EXPECT_EQ(CheckEdges(a.indices).not_two, 0u) << e.path();
+    EXPECT_GE(a.indices.size() / 3, 10000u) << e.path();
+    float top = -1e9f, bottom = 1e9f;
+    for (const MeshVertex& v : a.bind_vertices) {
+      top = std::max(top, v.position.z());
+      bottom = std::min(bottom, v.position.z());
+    }
+    EXPECT_NEAR(top - bottom, a.params.height_m, 0.01) << e.path();
+    lowest = std::min(lowest, a.params.height_m);
+    highest = std::max(highest, a.params.height_m);
+    slimmest = std::min(slimmest, a.params.build);
+    heaviest = std::max(heaviest, a.params.build);
+    std::ifstream in(e.path());
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    loose += text.find("loose_shirt") != std::string::npos || text.find("jacket") != std::string::npos;
+  }
+  EXPECT_GE(persons, 8);
+  EXPECT_GE(loose, 2);
+  EXPECT_LE(lowest, 1.52);
+  EXPECT_GE(highest, 1.93);
+  EXPECT_LE(slimmest, 0.85);
+  EXPECT_GE(heaviest, 1.25);
 }
 
 }  // namespace

@@ -1,0 +1,671 @@
+#include "sim/body/avatar_import.h"
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <unistd.h>
+
+#include "common/error.h"
+
+namespace irbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------
+// Joint-name tables.
+
+std::vector<std::string> Sided(const std::vector<std::string>& names, const std::string& left, const std::string& right,
+                               bool prefix) {
+  std::vector<std::string> out;
+  for (const std::string& n : names) {
+    out.push_back(prefix ? left + n : n + left);
+    out.push_back(prefix ? right + n : n + right);
+  }
+  return out;
+}
+
+// Expects `map` to hold exactly these canonical -> rig pairs (among others).
+void ExpectMapped(const JointMapping& m, const std::map<std::string, std::string>& expected) {
+  for (const auto& [canonical, rig] : expected) {
+    const auto it = m.map.find(canonical);
+    ASSERT_NE(it, m.map.end()) << canonical << " unmapped (convention " << m.convention << ")";
+    EXPECT_EQ(it->second, rig) << canonical;
+  }
+}
+
+TEST(MapRigJointsTest, Mixamo) {
+  std::vector<std::string> names = {"mixamorig:Hips", "mixamorig:Spine", "mixamorig:Spine1", "mixamorig:Spine2",
+                                    "mixamorig:Neck", "mixamorig:Head",  "mixamorig:HeadTop_End"};
+  for (const std::string& n : Sided({"Shoulder", "Arm", "ForeArm", "Hand", "HandIndex1", "HandThumb1", "UpLeg", "Leg",
+                                     "Foot", "ToeBase"},
+                                    "mixamorig:Left", "mixamorig:Right", true)) {
+    names.push_back(n);
+  }
+  const JointMapping m = MapRigJoints(names, {});
+  EXPECT_EQ(m.convention, "mixamo");
+  ExpectMapped(m, {{"pelvis", "mixamorig:Hips"},
+                   {"spine", "mixamorig:Spine"},
+                   {"chest", "mixamorig:Spine2"},
+                   {"neck", "mixamorig:Neck"},
+                   {"head", "mixamorig:Head"},
+                   {"right_clavicle", "mixamorig:RightShoulder"},
+                   {"right_shoulder", "mixamorig:RightArm"},
+                   {"right_elbow", "mixamorig:RightForeArm"},
+                   {"right_wrist", "mixamorig:RightHand"},
+                   {"left_clavicle", "mixamorig:LeftShoulder"},
+                   {"left_shoulder", "mixamorig:LeftArm"},
+                   {"left_elbow", "mixamorig:LeftForeArm"},
+                   {"left_wrist", "mixamorig:LeftHand"},
+                   {"right_hip", "mixamorig:RightUpLeg"},
+                   {"right_knee", "mixamorig:RightLeg"},
+                   {"right_ankle", "mixamorig:RightFoot"},
+                   {"left_hip", "mixamorig:LeftUpLeg"},
+                   {"left_knee", "mixamorig:LeftLeg"},
+                   {"left_ankle", "mixamorig:LeftFoot"}});
+  EXPECT_EQ(m.map.size(), 19u);
+  // Unmapped: Spine1, HeadTop_End, fingers and toes.
+  EXPECT_EQ(m.unmapped_rig_joints.size(), names.size() - 19);
+}
+
+TEST(MapRigJointsTest, Rigify) {
+  std::vector<std::string> names = {"DEF-spine",     "DEF-spine.001", "DEF-spine.002", "DEF-spine.003",
+                                    "DEF-spine.004", "DEF-spine.005", "DEF-spine.006"};
+  for (const char* side : {".L", ".R"}) {
+    for (const char* bone : {"DEF-shoulder", "DEF-upper_arm", "DEF-forearm", "DEF-hand", "DEF-thigh", "DEF-shin",
+                             "DEF-foot", "DEF-toe"}) {
+      names.push_back(std::string(bone) + side);
+    }
+    // Rigify's twist segments.
+    for (const char* bone : {"DEF-upper_arm", "DEF-forearm", "DEF-thigh", "DEF-shin"}) {
+      names.push_back(std::string(bone) + side + ".001");
+    }
+  }
+  const JointMapping m = MapRigJoints(names, {});
+  EXPECT_EQ(m.convention, "rigify");
+  ExpectMapped(m, {{"pelvis", "DEF-spine"},
+                   {"spine", "DEF-spine.001"},
+                   {"chest", "DEF-spine.002"},
+                   {"neck", "DEF-spine.004"},
+                   {"head", "DEF-spine.006"},
+                   {"right_clavicle", "DEF-shoulder.R"},
+                   {"right_shoulder", "DEF-upper_arm.R"},
+                   {"right_elbow", "DEF-forearm.R"},
+                   {"right_wrist", "DEF-hand.R"},
+                   {"left_clavicle", "DEF-shoulder.L"},
+                   {"left_shoulder", "DEF-upper_arm.L"},
+                   {"left_elbow", "DEF-forearm.L"},
+                   {"left_wrist", "DEF-hand.L"},
+                   {"left_hip", "DEF-thigh.L"},
+                   {"left_knee", "DEF-shin.L"},
+                   {"left_ankle", "DEF-foot.L"}});
+}
+
+TEST(MapRigJointsTest, BlenderMetarigIsGeneric) {
+  std::vector<std::string> names = {"hips", "spine", "chest", "neck", "head"};
+  for (const std::string& n : Sided({"shoulder", "upper_arm", "forearm", "hand", "thigh", "shin", "foot"}, ".L", ".R", false)) {
+    names.push_back(n);
+  }
+  const JointMapping m = MapRigJoints(names, {});
+  EXPECT_EQ(m.convention, "generic");
+  ExpectMapped(m, {{"pelvis", "hips"},
+                   {"spine", "spine"},
+                   {"chest", "chest"},
+                   {"neck", "neck"},
+                   {"head", "head"},
+                   {"left_clavicle", "shoulder.L"},
+                   {"left_shoulder", "upper_arm.L"},
+                   {"left_elbow", "forearm.L"},
+                   {"left_wrist", "hand.L"},
+                   {"right_shoulder", "upper_arm.R"},
+                   {"right_elbow", "forearm.R"},
+                   {"right_wrist", "hand.R"},
+                   {"right_knee", "shin.R"}});
+}
+
+TEST(MapRigJointsTest, MakeHumanDefaultAndGameEngine) {
+  std::vector<std::string> names = {"root",   "spine05", "spine04", "spine03", "spine02", "spine01",
+                                    "neck01", "neck02",  "neck03",  "head",    "jaw"};
+  for (const std::string& n : Sided({"clavicle", "shoulder01", "upperarm01", "upperarm02", "lowerarm01", "lowerarm02",
+                                     "wrist", "pelvis", "upperleg01", "upperleg02", "lowerleg01", "lowerleg02", "foot"},
+                                    ".L", ".R", false)) {
+    names.push_back(n);
+  }
+  const JointMapping m = MapRigJoints(names, {});
+  EXPECT_EQ(m.convention, "makehuman");
+  ExpectMapped(m, {{"pelvis", "root"},
+                   {"spine", "spine05"},
+                   {"chest", "spine03"},
+                   {"neck", "neck01"},
+                   {"head", "head"},
+                   {"left_clavicle", "clavicle.L"},
+                   {"left_shoulder", "upperarm01.L"},
+                   {"left_elbow", "lowerarm01.L"},
+                   {"left_wrist", "wrist.L"},
+                   {"right_shoulder", "upperarm01.R"},
+                   {"right_elbow", "lowerarm01.R"},
+                   {"right_wrist", "wrist.R"},
+                   {"right_hip", "upperleg01.R"},
+                   {"right_knee", "lowerleg01.R"},
+                   {"right_ankle", "foot.R"}});
+
+  std::vector<std::string> game = {"pelvis", "spine_01", "spine_02", "spine_03", "neck_01", "head"};
+  for (const std::string& n : Sided({"clavicle", "upperarm", "lowerarm", "hand", "thigh", "calf", "foot", "ball"}, "_l",
+                                    "_r", false)) {
+    game.push_back(n);
+  }
+  const JointMapping g = MapRigJoints(game, {});
+  EXPECT_EQ(g.convention, "unreal");
+  ExpectMapped(g, {{"pelvis", "pelvis"},
+                   {"spine", "spine_01"},
+                   {"chest", "spine_03"},
+                   {"neck", "neck_01"},
+                   {"head", "head"},
+                   {"right_shoulder", "upperarm_r"},
+                   {"right_elbow", "lowerarm_r"},
+                   {"right_wrist", "hand_r"},
+                   {"left_shoulder", "upperarm_l"},
+                   {"left_elbow", "lowerarm_l"},
+                   {"left_wrist", "hand_l"},
+                   {"left_knee", "calf_l"}});
+}
+
+const std::vector<std::string> kWizardJoints = {
+    "Root",     "Foot.L",     "Body",       "Hips",       "Abdomen",  "Torso",    "Neck",       "Head",
+    "Shoulder.L", "UpperArm.L", "LowerArm.L", "Fist.L",   "Fist1.L",  "Fist2.L",  "Thumb1.L",   "Thumb2.L",
+    "Shoulder.R", "UpperArm.R", "LowerArm.R", "Fist.R",   "Fist1.R",  "Fist2.R",  "Weapon.R",   "Thumb1.R",
+    "Thumb2.R", "UpperLeg.L", "LowerLeg.L", "UpperLeg.R", "LowerLeg.R", "PoleTarget.L", "Foot.R", "PoleTarget.R"};
+
+TEST(MapRigJointsTest, Wizard) {
+  const JointMapping m = MapRigJoints(kWizardJoints, {});
+  ExpectMapped(m, {{"pelvis", "Hips"},
+                   {"spine", "Abdomen"},
+                   {"chest", "Torso"},
+                   {"neck", "Neck"},
+                   {"head", "Head"},
+                   {"right_clavicle", "Shoulder.R"},
+                   {"right_shoulder", "UpperArm.R"},
+                   {"right_elbow", "LowerArm.R"},
+                   {"right_wrist", "Fist.R"},
+                   {"left_clavicle", "Shoulder.L"},
+                   {"left_shoulder", "UpperArm.L"},
+                   {"left_elbow", "LowerArm.L"},
+                   {"left_wrist", "Fist.L"},
+                   {"right_hip", "UpperLeg.R"},
+                   {"right_knee", "LowerLeg.R"},
+                   {"right_ankle", "Foot.R"},
+                   {"left_hip", "UpperLeg.L"},
+                   {"left_knee", "LowerLeg.L"},
+                   {"left_ankle", "Foot.L"}});
+}
+
+TEST(MapRigJointsTest, CesiumManAndRiggedFigure) {
+  // CesiumMan numbers its two arms differently (verified on the joint
+  // positions: L__4_ -> L__3_ -> L__2_ and R -> R__2_ -> R__3_ run outwards).
+  const std::vector<std::string> cesium_man = {
+      "Skeleton_torso_joint_1", "Skeleton_torso_joint_2", "torso_joint_3", "Skeleton_neck_joint_1",
+      "Skeleton_neck_joint_2", "Skeleton_arm_joint_L__4_", "Skeleton_arm_joint_R", "Skeleton_arm_joint_L__3_",
+      "Skeleton_arm_joint_R__2_", "Skeleton_arm_joint_L__2_", "Skeleton_arm_joint_R__3_", "leg_joint_L_1",
+      "leg_joint_R_1", "leg_joint_L_2", "leg_joint_R_2", "leg_joint_L_3", "leg_joint_R_3", "leg_joint_L_5",
+      "leg_joint_R_5"};
+  const JointMapping m = MapRigJoints(cesium_man, {});
+  EXPECT_EQ(m.convention, "cesium");
+  ExpectMapped(m, {{"pelvis", "Skeleton_torso_joint_1"},
+                   {"spine", "Skeleton_torso_joint_2"},
+                   {"chest", "torso_joint_3"},
+                   {"neck", "Skeleton_neck_joint_1"},
+                   {"head", "Skeleton_neck_joint_2"},
+                   {"left_shoulder", "Skeleton_arm_joint_L__4_"},
+                   {"left_elbow", "Skeleton_arm_joint_L__3_"},
+                   {"left_wrist", "Skeleton_arm_joint_L__2_"},
+                   {"right_shoulder", "Skeleton_arm_joint_R"},
+                   {"right_elbow", "Skeleton_arm_joint_R__2_"},
+                   {"right_wrist", "Skeleton_arm_joint_R__3_"},
+                   {"left_hip", "leg_joint_L_1"},
+                   {"left_knee", "leg_joint_L_2"},
+                   {"left_ankle", "leg_joint_L_3"},
+                   {"right_ankle", "leg_joint_R_3"}});
+  EXPECT_EQ(m.map.count("left_clavicle"), 0u);
+
+  const std::vector<std::string> figure = {
+      "torso_joint_1", "torso_joint_2", "torso_joint_3", "neck_joint_1",  "neck_joint_2",  "arm_joint_L_1",
+      "arm_joint_R_1", "arm_joint_L_2", "arm_joint_R_2", "arm_joint_L_3", "arm_joint_R_3", "leg_joint_L_1",
+      "leg_joint_R_1", "leg_joint_L_2", "leg_joint_R_2", "leg_joint_L_3", "leg_joint_R_3", "leg_joint_L_5",
+      "leg_joint_R_5"};
+  const JointMapping f = MapRigJoints(figure, {});
+  EXPECT_EQ(f.convention, "cesium");
+  ExpectMapped(f, {{"pelvis", "torso_joint_1"},
+                   {"neck", "neck_joint_1"},
+                   {"head", "neck_joint_2"},
+                   {"left_shoulder", "arm_joint_L_1"},
+                   {"left_elbow", "arm_joint_L_2"},
+                   {"left_wrist", "arm_joint_L_3"},
+                   {"right_shoulder", "arm_joint_R_1"},
+                   {"right_elbow", "arm_joint_R_2"},
+                   {"right_wrist", "arm_joint_R_3"},
+                   {"right_hip", "leg_joint_R_1"}});
+  EXPECT_EQ(f.unmapped_rig_joints, (std::vector<std::string>{"leg_joint_L_5", "leg_joint_R_5"}));
+}
+
+TEST(MapRigJointsTest, OverridesWinAndAreChecked) {
+  const JointMapping m = MapRigJoints(kWizardJoints, {{"right_wrist", "fist1.r"}, {"left_clavicle", ""}});
+  EXPECT_EQ(m.map.at("right_wrist"), "Fist1.R");
+  EXPECT_EQ(m.map.count("left_clavicle"), 0u);
+  // The override takes the rig joint from the table's choice.
+  const JointMapping n = MapRigJoints(kWizardJoints, {{"right_elbow", "Fist.R"}});
+  EXPECT_EQ(n.map.at("right_elbow"), "Fist.R");
+  EXPECT_EQ(n.map.count("right_wrist"), 0u);
+  try {
+    MapRigJoints(kWizardJoints, {{"right_hand", "Fist.R"}});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "joint_map.right_hand");
+  }
+  try {
+    MapRigJoints(kWizardJoints, {{"right_wrist", "Paw.R"}});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "joint_map.right_wrist");
+  }
+  EXPECT_EQ(MapRigJoints({"a", "b"}, {}).convention, "unknown");
+}
+
+// ---------------------------------------------------------------------------
+// Importing the test avatars.
+
+fs::path AvatarDir() { return fs::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "avatars"; }
+
+fs::path TempDir() {
+  const fs::path dir = fs::temp_directory_path() / ("irbench_import_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+// The field of the InputError `f` throws.
+template <class F>
+std::string ErrorField(F&& f, std::string* message = nullptr) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    if (message) *message = e.what();
+    return e.field();
+  }
+  return "(no InputError)";
+}
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+struct Case {
+  const char* file;
+  double scale;
+  double expected_height;  // metres
+};
+
+// Expected heights: CesiumMan and rigged_figure from SOURCE.md (bind pose,
+// skinned, metres). Wizard: 3.078 file units = the bind-pose vertical extent of
+// the skinned body plus the rigid meshes the importer keeps (Face on Head,
+// shoulder pads, pouch; not the staff), y from -0.0033 to 3.0747, measured with
+// a separate Python script reading the GLB's JSON and BIN chunks (raw skinned
+// positions; rigid meshes placed by their joint's inverse bind matrix), at the
+// 0.6 m per unit the test imports it with.
+const Case kCases[] = {{"CesiumMan.glb", 0, 1.507}, {"rigged_figure.glb", 0, 1.450}, {"Wizard.glb", 0.6, 0.6 * 3.078}};
+
+class ImportTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ImportTest, StandsInTheCanonicalTPose) {
+  const Case c = GetParam();
+  const fs::path file = AvatarDir() / c.file;
+  if (!fs::exists(file)) GTEST_SKIP() << file << " is not here";
+  ImportOptions options;
+  options.scale = c.scale;
+  Avatar avatar;
+  ASSERT_NO_THROW(avatar = ImportRiggedAvatar(file, options));
+  const auto& b = avatar.skeleton.bind_position;
+  const double h = avatar.params.height_m;
+  EXPECT_EQ(avatar.params.name, file.stem().string());
+  EXPECT_EQ(avatar.params.build, 1.0);
+  EXPECT_GE(h, 1.0);
+  EXPECT_LE(h, 2.3);
+  EXPECT_NEAR(h, c.expected_height, 0.03);
+
+  // Mesh: finite, on the floor, as tall as the parameters say.
+  ASSERT_FALSE(avatar.bind_vertices.empty());
+  ASSERT_EQ(avatar.indices.size() % 3, 0u);
+  for (uint32_t i : avatar.indices) ASSERT_LT(i, avatar.bind_vertices.size());
+  double lo = 1e9, hi = -1e9;
+  size_t max_x = 0, min_x = 0;
+  for (size_t i = 0; i < avatar.bind_vertices.size(); ++i) {
+    const MeshVertex& v = avatar.bind_vertices[i];
+    ASSERT_TRUE(v.position.allFinite()) << i;
+    ASSERT_TRUE(v.normal.allFinite()) << i;
+    EXPECT_NEAR(v.normal.norm(), 1.0f, 1e-4f);
+    EXPECT_GE(v.albedo, 0.0f);
+    EXPECT_LE(v.albedo, 1.0f);
+    EXPECT_EQ(v.emissive, 0.0f);
+    lo = std::min<double>(lo, v.position.z());
+    hi = std::max<double>(hi, v.position.z());
+    if (v.position.x() > avatar.bind_vertices[max_x].position.x()) max_x = i;
+    if (v.position.x() < avatar.bind_vertices[min_x].position.x()) min_x = i;
+  }
+  EXPECT_NEAR(lo, 0.0, 1e-5);
+  EXPECT_NEAR(hi, h, 1e-5);
+  EXPECT_NEAR(b[kPelvis].x(), 0.0, 1e-9);
+  EXPECT_NEAR(b[kPelvis].y(), 0.0, 1e-9);
+
+  // Weights.
+  ASSERT_EQ(avatar.bone_weight.size(), avatar.bind_vertices.size());
+  ASSERT_EQ(avatar.bone_index.size(), avatar.bind_vertices.size());
+  for (size_t i = 0; i < avatar.bone_weight.size(); ++i) {
+    const auto& w = avatar.bone_weight[i];
+    EXPECT_NEAR(w[0] + w[1] + w[2] + w[3], 1.0f, 1e-5f) << i;
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_GE(w[k], 0.0f);
+      EXPECT_LT(avatar.bone_index[i][k], kJointCount);
+    }
+  }
+
+  // T-pose.
+  for (const auto& [shoulder, sign] : {std::pair{kRightShoulder, 1.0}, std::pair{kLeftShoulder, -1.0}}) {
+    const Eigen::Vector3d x(sign, 0, 0);
+    const double upper = AngleDeg(b[shoulder + 1] - b[shoulder], x);
+    const double fore = AngleDeg(b[shoulder + 2] - b[shoulder + 1], x);
+    EXPECT_LT(upper, 3.0) << JointName(shoulder);
+    EXPECT_LT(fore, 3.0) << JointName(shoulder);
+  }
+  for (int hip : {kRightHip, kLeftHip}) {
+    const Eigen::Vector3d down(0, 0, -1);
+    EXPECT_LT(AngleDeg(b[hip + 1] - b[hip], down), 5.0) << JointName(hip);
+    EXPECT_LT(AngleDeg(b[hip + 2] - b[hip + 1], down), 5.0) << JointName(hip);
+  }
+  EXPECT_LT(AngleDeg(b[kNeck] - b[kChest], Eigen::Vector3d::UnitZ()), 3.0);
+  EXPECT_GT(b[kRightShoulder].x(), 0.05);
+  EXPECT_LT(b[kLeftShoulder].x(), -0.05);
+  EXPECT_GT(b[kRightHip].x(), 0.0);
+  EXPECT_LT(b[kLeftHip].x(), 0.0);
+  // Seen on the mesh alone: the outermost vertices are the hands, level with
+  // the shoulders (an A-pose would put them 0.2-0.4 m lower), beyond the wrists.
+  const Eigen::Vector3d right_end = avatar.bind_vertices[max_x].position.cast<double>();
+  const Eigen::Vector3d left_end = avatar.bind_vertices[min_x].position.cast<double>();
+  EXPECT_NEAR(right_end.z(), b[kRightShoulder].z(), 0.06 * h);
+  EXPECT_NEAR(left_end.z(), b[kLeftShoulder].z(), 0.06 * h);
+  EXPECT_GT(right_end.x(), b[kRightWrist].x());
+  EXPECT_LT(left_end.x(), b[kLeftWrist].x());
+  // Facing +y: the soles reach further forward than back from the ankles.
+  double sole_front = -1e9, sole_back = 1e9;
+  for (const MeshVertex& v : avatar.bind_vertices) {
+    if (v.position.z() > 0.03 * h) continue;
+    sole_front = std::max<double>(sole_front, v.position.y());
+    sole_back = std::min<double>(sole_back, v.position.y());
+  }
+  const double ankle_y = 0.5 * (b[kRightAnkle].y() + b[kLeftAnkle].y());
+  EXPECT_GT(sole_front - ankle_y, ankle_y - sole_back);
+
+  // Markers and radii.
+  const JointTransforms bind = ForwardKinematics(avatar.skeleton, Pose());
+  const auto truth = TruthJoints(avatar, bind);
+  const auto& names = TruthJointNames();
+  for (size_t i = 0; i < truth.size(); ++i) EXPECT_TRUE(truth[i].allFinite()) << names[i];
+  EXPECT_GT(truth[3].z(), truth[2].z());              // head above the neck
+  EXPECT_GT(truth[11].x(), b[kRightWrist].x() + 0.02);  // right hand tip beyond the wrist
+  EXPECT_NEAR(truth[11].x(), right_end.x(), 0.01);    // ... at the end of the hand
+  EXPECT_LT(truth[7].x(), b[kLeftWrist].x() - 0.02);
+  for (const char* key : {"root", "waist", "neck", "head", "shoulder", "elbow", "wrist", "hand_tip", "hip", "knee", "ankle"}) {
+    ASSERT_TRUE(avatar.truth_radius.count(key)) << key;
+    EXPECT_GE(avatar.truth_radius.at(key), 0.0) << key;
+    EXPECT_LT(avatar.truth_radius.at(key), 0.3) << key;
+  }
+
+  // Identity pose reproduces the bind mesh.
+  std::vector<MeshVertex> skinned;
+  SkinVertices(avatar, bind, skinned);
+  ASSERT_EQ(skinned.size(), avatar.bind_vertices.size());
+  double worst = 0;
+  for (size_t i = 0; i < skinned.size(); ++i) {
+    worst = std::max<double>(worst, (skinned[i].position - avatar.bind_vertices[i].position).norm());
+  }
+  EXPECT_LT(worst, 1e-5);
+
+  // Bending the right elbow moves the right hand only.
+  Pose pose;
+  pose.local_rotation[kRightElbow] = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  SkinVertices(avatar, ForwardKinematics(avatar.skeleton, pose), skinned);
+  EXPECT_GT((skinned[max_x].position - avatar.bind_vertices[max_x].position).norm(), 0.1);
+  EXPECT_LT((skinned[min_x].position - avatar.bind_vertices[min_x].position).norm(), 1e-5);
+
+  std::printf("%s: height %.3f m, %zu vertices, %zu triangles; shoulders %.3f apart at z %.3f, wrists x %.3f/%.3f, "
+              "hand tips x %.3f/%.3f, head %.3f; radii waist %.3f neck %.3f head %.3f shoulder %.3f elbow %.3f "
+              "wrist %.3f hand_tip %.3f hip %.3f knee %.3f ankle %.3f\n",
+              c.file, h, avatar.bind_vertices.size(), avatar.indices.size() / 3,
+              (b[kRightShoulder] - b[kLeftShoulder]).norm(), b[kRightShoulder].z(), b[kRightWrist].x(),
+              b[kLeftWrist].x(), truth[11].x(), truth[7].x(), truth[3].z(), avatar.truth_radius.at("waist"),
+              avatar.truth_radius.at("neck"), avatar.truth_radius.at("head"), avatar.truth_radius.at("shoulder"),
+              avatar.truth_radius.at("elbow"), avatar.truth_radius.at("wrist"), avatar.truth_radius.at("hand_tip"),
+              avatar.truth_radius.at("hip"), avatar.truth_radius.at("knee"), avatar.truth_radius.at("ankle"));
+}
+
+INSTANTIATE_TEST_SUITE_P(Avatars, ImportTest, ::testing::ValuesIn(kCases),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           std::string s = fs::path(info.param.file).stem().string();
+                           for (char& ch : s) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+                           return s;
+                         });
+
+// ---------------------------------------------------------------------------
+// GLB surgery for the error cases: the JSON chunk edited, the BIN chunk kept.
+
+struct Glb {
+  nlohmann::json json;
+  std::string bin;
+};
+
+Glb ReadGlb(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto u32 = [&](size_t at) {
+    uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+  };
+  Glb glb;
+  const uint32_t json_length = u32(12);
+  glb.json = nlohmann::json::parse(bytes.substr(20, json_length));
+  const size_t bin_at = 20 + json_length;
+  if (bin_at + 8 <= bytes.size()) glb.bin = bytes.substr(bin_at + 8, u32(bin_at));
+  return glb;
+}
+
+void WriteGlb(const fs::path& path, const Glb& glb) {
+  std::string json = glb.json.dump();
+  while (json.size() % 4) json += ' ';
+  std::string bin = glb.bin;
+  while (bin.size() % 4) bin += '\0';
+  std::string out;
+  auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  out += "glTF";
+  u32(2);
+  u32(static_cast<uint32_t>(12 + 8 + json.size() + (bin.empty() ? 0 : 8 + bin.size())));
+  u32(static_cast<uint32_t>(json.size()));
+  u32(0x4E4F534A);
+  out += json;
+  if (!bin.empty()) {
+    u32(static_cast<uint32_t>(bin.size()));
+    u32(0x004E4942);
+    out += bin;
+  }
+  std::ofstream(path, std::ios::binary) << out;
+}
+
+void RenameNodes(Glb& glb, const std::map<std::string, std::string>& renames) {
+  for (auto& node : glb.json["nodes"]) {
+    if (!node.contains("name")) continue;
+    const auto it = renames.find(node["name"].get<std::string>());
+    if (it != renames.end()) node["name"] = it->second;
+  }
+}
+
+class ImportErrorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    figure_ = AvatarDir() / "rigged_figure.glb";
+    if (!fs::exists(figure_)) GTEST_SKIP() << figure_ << " is not here";
+    dir_ = TempDir();
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+  fs::path figure_, dir_;
+};
+
+TEST(ImportErrors, MissingFile) {
+  std::string message;
+  EXPECT_EQ(ErrorField([] { ImportRiggedAvatar("/nonexistent/irbench/avatar.glb"); }, &message), "file");
+  EXPECT_NE(message.find("/nonexistent/irbench/avatar.glb"), std::string::npos) << message;
+}
+
+TEST_F(ImportErrorTest, CorruptGlb) {
+  std::ifstream in(figure_, std::ios::binary);
+  std::string head(200, '\0');
+  in.read(head.data(), 200);
+  const fs::path truncated = dir_ / "truncated.glb";
+  std::ofstream(truncated, std::ios::binary) << head;
+  std::string message;
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(truncated); }, &message), "file");
+  std::printf("truncated: %s\n", message.c_str());
+
+  std::mt19937 rng(7);
+  std::string noise(4096, '\0');
+  for (char& ch : noise) ch = static_cast<char>(rng() & 0xff);
+  for (const char* name : {"noise.glb", "noise.gltf", "noise.fbx"}) {
+    std::ofstream(dir_ / name, std::ios::binary) << noise;
+    EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(dir_ / name); }, &message), "file") << name;
+    std::printf("%s: %s\n", name, message.c_str());
+  }
+  // A GLB header with garbage after it.
+  std::string fake = head.substr(0, 20) + noise;
+  std::ofstream(dir_ / "garbage.glb", std::ios::binary) << fake;
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(dir_ / "garbage.glb"); }, &message), "file");
+}
+
+TEST_F(ImportErrorTest, RenamedArmJointsAreNoArmChain) {
+  Glb glb = ReadGlb(figure_);
+  RenameNodes(glb, {{"arm_joint_R_1", "bone_a"}, {"arm_joint_R_2", "bone_b"}});
+  const fs::path file = dir_ / "no_arm.glb";
+  WriteGlb(file, glb);
+  std::string message;
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(file); }, &message), "skin");
+  EXPECT_NE(message.find("no arm chain"), std::string::npos) << message;
+  EXPECT_NE(message.find("right_shoulder, right_elbow"), std::string::npos) << message;
+  EXPECT_NE(message.find("bone_a"), std::string::npos) << message;
+  EXPECT_EQ(message.find("left_shoulder"), std::string::npos) << message;
+  std::printf("%s\n", message.c_str());
+  // A joint map names them.
+  ImportOptions options;
+  options.joint_map = {{"right_shoulder", "bone_a"}, {"right_elbow", "bone_b"}};
+  EXPECT_NO_THROW(ImportRiggedAvatar(file, options));
+}
+
+TEST_F(ImportErrorTest, NoSkinAndNoMesh) {
+  Glb glb = ReadGlb(figure_);
+  glb.json.erase("skins");
+  for (auto& node : glb.json["nodes"]) node.erase("skin");
+  glb.json.erase("animations");
+  const fs::path file = dir_ / "no_skin.glb";
+  WriteGlb(file, glb);
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(file); }), "skin");
+
+  const fs::path obj = dir_ / "triangle.obj";
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::string message;
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(obj); }, &message), "skin");
+  std::printf("obj: %s\n", message.c_str());
+}
+
+TEST_F(ImportErrorTest, BadOptionsAndHeight) {
+  ImportOptions options;
+  options.up_axis = "w";
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(figure_, options); }), "up_axis");
+  options = {};
+  options.scale = -1;
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(figure_, options); }), "scale");
+  options = {};
+  options.joint_map = {{"right_wrist", "no_such_joint"}};
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(figure_, options); }), "joint_map.right_wrist");
+  options = {};
+  options.scale = 3.0;  // a 4.35 m giant
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(figure_, options); }), "height");
+  const fs::path wizard = AvatarDir() / "Wizard.glb";
+  if (fs::exists(wizard)) {
+    std::string message;
+    EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(wizard); }, &message), "height");  // 3 units, glTF metres
+    std::printf("%s\n", message.c_str());
+  }
+}
+
+// The same figure with its left/right joint names swapped: the feet give the
+// sides away and the import comes out the same.
+TEST_F(ImportErrorTest, SwappedSideNamesAreDetected) {
+  Glb glb = ReadGlb(figure_);
+  std::map<std::string, std::string> swap;
+  for (const char* chain : {"arm_joint_", "leg_joint_"}) {
+    for (const char* k : {"1", "2", "3", "5"}) {
+      swap[std::string(chain) + "L_" + k] = std::string(chain) + "R_" + k;
+      swap[std::string(chain) + "R_" + k] = std::string(chain) + "L_" + k;
+    }
+  }
+  RenameNodes(glb, swap);
+  const fs::path file = dir_ / "swapped.glb";
+  WriteGlb(file, glb);
+  const Avatar reference = ImportRiggedAvatar(figure_);
+  const Avatar swapped = ImportRiggedAvatar(file);
+  for (int j = 0; j < kJointCount; ++j) {
+    EXPECT_LT((swapped.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 1e-6) << JointName(j);
+  }
+  ASSERT_EQ(swapped.bind_vertices.size(), reference.bind_vertices.size());
+  for (size_t i = 0; i < swapped.bind_vertices.size(); ++i) {
+    ASSERT_LT((swapped.bind_vertices[i].position - reference.bind_vertices[i].position).norm(), 1e-5f) << i;
+  }
+}
+
+// Up axis given or found, same result; Collada through assimp, same body.
+TEST_F(ImportErrorTest, UpAxisOptionAndAssimpPath) {
+  const Avatar reference = ImportRiggedAvatar(figure_);
+  ImportOptions options;
+  options.up_axis = "y";  // the figure's node tree turns its z-up mesh y-up
+  const Avatar y_up = ImportRiggedAvatar(figure_, options);
+  for (int j = 0; j < kJointCount; ++j) {
+    EXPECT_LT((y_up.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 1e-6) << JointName(j);
+  }
+
+  // glTF -> Collada with assimp's own exporter, then imported through assimp.
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(figure_.string(), 0);
+  ASSERT_NE(scene, nullptr) << importer.GetErrorString();
+  const fs::path dae = dir_ / "figure.dae";
+  Assimp::Exporter exporter;
+  ASSERT_EQ(exporter.Export(scene, "collada", dae.string()), AI_SUCCESS) << exporter.GetErrorString();
+  Avatar from_dae;
+  ASSERT_NO_THROW(from_dae = ImportRiggedAvatar(dae));
+  EXPECT_NEAR(from_dae.params.height_m, 1.450, 0.03);
+  for (int j = 0; j < kJointCount; ++j) {
+    EXPECT_LT((from_dae.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 0.01) << JointName(j);
+  }
+  for (const auto& w : from_dae.bone_weight) EXPECT_NEAR(w[0] + w[1] + w[2] + w[3], 1.0f, 1e-5f);
+  std::vector<MeshVertex> skinned;
+  SkinVertices(from_dae, ForwardKinematics(from_dae.skeleton, Pose()), skinned);
+  for (size_t i = 0; i < skinned.size(); ++i) {
+    ASSERT_LT((skinned[i].position - from_dae.bind_vertices[i].position).norm(), 1e-5f);
+  }
+}
+
+}  // namespace
+}  // namespace irbench

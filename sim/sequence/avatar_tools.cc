@@ -1,0 +1,82 @@
+#include "sim/sequence/avatar_tools.h"
+
+#include <algorithm>
+#include <map>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/json_reader.h"
+#include "common/paths.h"
+#include "sim/body/avatar.h"
+#include "sim/body/gltf_export.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+
+std::string AvatarListText() {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(DataRoot() / "avatars", ec)) {
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::ostringstream out;
+  for (const fs::path& f : files) {
+    char line[512];
+    try {
+      const JsonNode root = ParseJsonFile(f.string());
+      std::snprintf(line, sizeof(line), "%-8s %-11s %.2f m  %s\n", f.stem().string().c_str(),
+                    root.GetString("kind", "?").c_str(), root.GetDouble("height_m", 0.0),
+                    root.GetString("description", "").c_str());
+    } catch (const InputError& e) {
+      std::snprintf(line, sizeof(line), "%-8s (unreadable: %s)\n", f.stem().string().c_str(), e.what());
+    }
+    out << line;
+  }
+  return out.str();
+}
+
+std::string AvatarInfoText(const std::string& name_or_path) {
+  const fs::path file = ResolveDataFile("avatars", name_or_path, "AVATAR");
+  const Avatar a = LoadAvatar(file);
+  float top = -1e9f, bottom = 1e9f;
+  for (const MeshVertex& v : a.bind_vertices) {
+    top = std::max(top, v.position.z());
+    bottom = std::min(bottom, v.position.z());
+  }
+  std::map<std::pair<uint32_t, uint32_t>, int> edges;
+  for (size_t t = 0; t < a.indices.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t u = a.indices[t + e], v = a.indices[t + (e + 1) % 3];
+      ++edges[{std::min(u, v), std::max(u, v)}];
+    }
+  }
+  size_t open = 0;
+  for (const auto& [edge, count] : edges) open += count != 2;
+  std::ostringstream out;
+  out << "avatar      " << a.params.name << " (" << file.string() << ")\n"
+      << "kind        " << a.params.kind << "\n"
+      << "height      " << top - bottom << " m (parameter " << a.params.height_m << " m)\n"
+      << "build       " << a.params.build << "\n"
+      << "triangles   " << a.indices.size() / 3 << "\n"
+      << "vertices    " << a.bind_vertices.size() << "\n"
+      << "watertight  " << (open == 0 ? "yes" : "no: " + std::to_string(open) + " edges not shared by two faces")
+      << "\n"
+      << "joints      " << kJointCount << " (canonical skeleton)\n";
+  return out.str();
+}
+
+fs::path ExportAvatar(const std::string& name_or_path, const fs::path& out, bool overwrite) {
+  if (out.empty()) throw InputError("", "OUT", "no output file");
+  if (fs::exists(out) && !overwrite) {
+    throw InputError("", "OUT", "'" + out.string() + "' exists (pass --force to replace it)");
+  }
+  if (!fs::is_directory(fs::absolute(out).parent_path())) {
+    throw InputError("", "OUT", "folder '" + fs::absolute(out).parent_path().string() + "' does not exist");
+  }
+  const Avatar avatar = LoadAvatar(ResolveDataFile("avatars", name_or_path, "AVATAR"));
+  WriteAvatarGlb(avatar, out);
+  return out;
+}
+
+}  // namespace irbench
