@@ -187,7 +187,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["rig"] = {{"name", in.rig.name}, {"file", in.rig_file.filename().string()}};
   manifest["avatar"] = {{"name", in.avatar.params.name},
                         {"file", in.avatar_file.filename().string()},
-                        {"kind", "tube"},
+                        {"kind", in.avatar.params.kind},
                         {"build", in.avatar.params.build}};
   manifest["motion"] = {{"name", in.motion_name},
                         {"file", in.motion_file.empty() ? nlohmann::json(nullptr)
