@@ -27,7 +27,7 @@ void AddRenderInputOptions(CLI::App* cmd,
                            std::string& shadows) {
   cmd->add_option("--scene", o.scene, "scene name (scenes/) or file; default: the rig's scene");
   cmd->add_option("--rig", o.rig, "camera rig name (rigs/) or file")->capture_default_str();
-  cmd->add_option("--avatar", o.avatar, "avatar name (avatars/) or file")->capture_default_str();
+  cmd->add_option("--avatar", o.avatar, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->capture_default_str();
   cmd->add_option("--motion", o.motion,
                   "a library motion (irbench motion list), a file in motions/ (keyframes or session "
                   "script), or a path to a .json, .bvh or .amc file")
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
       "export", "Write a motion, posed on an avatar, as BVH (Blender, assimp, MotionBuilder open it)");
   motion_export->add_option("--motion", export_options.motion, "motion, as for render --motion")
       ->required();
-  motion_export->add_option("--avatar", export_options.avatar, "avatar name or file")->capture_default_str();
+  motion_export->add_option("--avatar", export_options.avatar, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->capture_default_str();
   motion_export->add_option("--scene", export_options.scene, "scene (for pointing targets)")
       ->capture_default_str();
   motion_export->add_option("--fps", export_options.fps, "frames per second")->capture_default_str();
@@ -111,13 +111,13 @@ int main(int argc, char** argv) {
   CLI::App* avatar_list = avatar_cmd->add_subcommand("list", "List the avatars in avatars/");
   std::string avatar_name;
   CLI::App* avatar_info = avatar_cmd->add_subcommand("info", "Height, triangles and closedness of an avatar");
-  avatar_info->add_option("AVATAR", avatar_name, "avatar name (avatars/) or file")->required();
+  avatar_info->add_option("AVATAR", avatar_name, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->required();
   std::string avatar_export_name;
   std::filesystem::path avatar_out;
   bool avatar_force = false;
   CLI::App* avatar_export = avatar_cmd->add_subcommand(
       "export", "Write an avatar as binary glTF (.glb): mesh, skeleton and skin, for Blender or any viewer");
-  avatar_export->add_option("AVATAR", avatar_export_name, "avatar name (avatars/) or file")->required();
+  avatar_export->add_option("AVATAR", avatar_export_name, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->required();
   avatar_export->add_option("OUT", avatar_out, "output .glb file")->required();
   avatar_export->add_flag("--force", avatar_force, "replace an existing file");
 

@@ -17,6 +17,7 @@ std::string FormatInputError(const std::string& file,
 InputError::InputError(std::string file, std::string field, const std::string& message)
     : std::runtime_error(FormatInputError(file, field, message)),
       file_(std::move(file)),
-      field_(std::move(field)) {}
+      field_(std::move(field)),
+      message_(message) {}
 
 }  // namespace irbench

@@ -16,10 +16,13 @@ class InputError : public std::runtime_error {
 
   const std::string& file() const { return file_; }
   const std::string& field() const { return field_; }
+  // The message without the file and field.
+  const std::string& message() const { return message_; }
 
  private:
   std::string file_;
   std::string field_;
+  std::string message_;
 };
 
 class RuntimeError : public std::runtime_error {

@@ -8,6 +8,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "tests/test_util.h"
@@ -198,6 +201,60 @@ TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
     EXPECT_NE(bad.err.find("tall.json: height_m"), std::string::npos) << bad.err;
   }
   EXPECT_FALSE(fs::exists(dir / "tall.glb"));
+  EXPECT_FALSE(fs::exists(dir / "seq"));
+}
+
+// Renames nodes in a GLB's JSON chunk (the BIN chunk kept as is).
+void RenameGlbNodes(const fs::path& in, const fs::path& out, const std::map<std::string, std::string>& names) {
+  const std::string bytes = ReadText(in);
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, bytes.data() + 12, 4);
+  auto json = nlohmann::json::parse(bytes.substr(20, json_length));
+  for (auto& node : json["nodes"]) {
+    const auto it = names.find(node.value("name", ""));
+    if (it != names.end()) node["name"] = it->second;
+  }
+  std::string text = json.dump();
+  while (text.size() % 4) text += ' ';
+  const std::string rest = bytes.substr(20 + json_length);
+  std::string glb = bytes.substr(0, 12);
+  const uint32_t total = static_cast<uint32_t>(20 + text.size() + rest.size()), length = static_cast<uint32_t>(text.size());
+  std::memcpy(glb.data() + 8, &total, 4);
+  glb.append(reinterpret_cast<const char*>(&length), 4);
+  glb += bytes.substr(16, 4) + text + rest;
+  WriteText(out, glb);
+}
+
+TEST(CliTest, RiggedMeshesAreAvatarsAndBadOnesAreRefused) {
+  const fs::path dir = FreshTempDir("cli_mesh_avatar");
+  ASSERT_EQ(RunIrbench({"avatar", "export", "p5", (dir / "p5.glb").string()}, dir).exit_code, 0);
+  // The GLB itself works wherever an avatar does.
+  const Result info = RunIrbench({"avatar", "info", (dir / "p5.glb").string()}, dir);
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("mesh"), std::string::npos) << info.out;
+  const Result render = RunIrbench({"render", "--frames", "1", "--background-frames", "0", "--rig", "lab4",
+                                    "--avatar", (dir / "p5.glb").string(), "--out", (dir / "ok").string()},
+                                   dir);
+  EXPECT_EQ(render.exit_code, 0) << render.err;
+  const auto manifest = nlohmann::json::parse(ReadText(dir / "ok" / "manifest.json"));
+  EXPECT_EQ(manifest["avatar"]["kind"], "mesh");
+
+  // A corrupt GLB (cut short) and a rig with no right arm chain: one line
+  // naming the file and field, exit 2, no sequence left behind.
+  WriteText(dir / "cut.glb", ReadText(dir / "p5.glb").substr(0, 400));
+  RenameGlbNodes(dir / "p5.glb", dir / "no_arm.glb", {{"right_shoulder", "bone_a"}, {"right_elbow", "bone_b"}});
+  for (const auto& [file, expected] : {std::pair<std::string, std::string>{"cut.glb", "cut.glb: file: "},
+                                       {"no_arm.glb", "no_arm.glb: skin: no arm chain"}}) {
+    for (const auto& args :
+         {std::vector<std::string>{"avatar", "info", (dir / file).string()},
+          std::vector<std::string>{"render", "--frames", "1", "--avatar", (dir / file).string(), "--out",
+                                   (dir / "seq").string()}}) {
+      const Result bad = RunIrbench(args, dir);
+      EXPECT_EQ(bad.exit_code, 2) << bad.err;
+      EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+      EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
+    }
+  }
   EXPECT_FALSE(fs::exists(dir / "seq"));
 }
 

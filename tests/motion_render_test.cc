@@ -13,6 +13,7 @@
 
 #include "sim/motion/retarget.h"
 #include "sim/sequence/render_job.h"
+#include "tests/mask_check.h"
 #include "tests/test_util.h"
 
 namespace irbench {
@@ -21,35 +22,6 @@ namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
 using irbench::testing::ReadText;
 using irbench::testing::WriteText;
-
-// Largest distance (px) of a visible truth joint from the mask, over the
-// sequence; counts the visible joints checked.
-double WorstVisibleJointOffMask(const fs::path& seq, int* visible) {
-  const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
-  std::ifstream truth(seq / "truth/frames.jsonl");
-  std::string line;
-  double worst = 0;
-  while (std::getline(truth, line)) {
-    const auto frame = nlohmann::json::parse(line);
-    char file[32];
-    std::snprintf(file, sizeof(file), "%06d.png", frame["frame"].get<int>());
-    for (const auto& cam : manifest["cameras"]) {
-      const cv::Mat mask = cv::imread((seq / "truth/masks" / cam.get<std::string>() / file).string(),
-                                      cv::IMREAD_UNCHANGED);
-      if (mask.empty()) return 1e9;
-      cv::Mat distance;
-      cv::distanceTransform(255 - mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-      for (const auto& [joint, uvv] : frame["joints2d"][cam.get<std::string>()].items()) {
-        if (uvv[2] != 2 || joint == "root") continue;
-        const int u = int(std::lround(double(uvv[0]))), v = int(std::lround(double(uvv[1])));
-        if (u < 0 || v < 0 || u >= mask.cols || v >= mask.rows) return 1e9;
-        worst = std::max(worst, double(distance.at<float>(v, u)));
-        ++*visible;
-      }
-    }
-  }
-  return worst;
-}
 
 TEST(MotionRenderTest, EveryCmuClipRetargetsAndRenders) {
   const std::vector<fs::path> files = irbench::testing::CmuClips();
@@ -72,7 +44,7 @@ TEST(MotionRenderTest, EveryCmuClipRetargetsAndRenders) {
       options.out = dir / (clip.stem().string() + "_" + person);
       const fs::path seq = RunRenderJob(options);
       int visible = 0;
-      const double worst = WorstVisibleJointOffMask(seq, &visible);
+      const double worst = irbench::testing::WorstVisibleJointOffMask(seq, &visible);
       EXPECT_GT(visible, 10) << clip.filename() << " on " << person;
       EXPECT_LE(worst, 2.0) << clip.filename() << " on " << person;
       const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
@@ -116,7 +88,7 @@ TEST(MotionRenderTest, AsfAmcRetargetsAndRenders) {
   options.out = dir / "seq";
   const fs::path seq = RunRenderJob(options);
   int visible = 0;
-  EXPECT_LE(WorstVisibleJointOffMask(seq, &visible), 2.0);
+  EXPECT_LE(irbench::testing::WorstVisibleJointOffMask(seq, &visible), 2.0);
   EXPECT_GT(visible, 10);
   const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
   EXPECT_EQ(manifest["motion"]["kind"], "amc");

@@ -86,7 +86,8 @@ inline std::string CmuStyleAsf() {
                   "  begin\n    id %d\n    name %s\n    direction %.6f %.6f %.6f\n    length %.6f\n"
                   "    axis 0 0 %d XYZ\n    dof rx ry rz\n    limits (-180 180)\n (-180 180)\n (-180 180)\n"
                   "  end\n",
-                  id++, b.name, b.dx / n, b.dy / n, b.dz / n, b.length, (id % 3) * 15);
+                  id, b.name, b.dx / n, b.dy / n, b.dz / n, b.length, (id % 3) * 15);
+    ++id;
     asf += text;
   }
   asf +=

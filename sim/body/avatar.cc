@@ -1,8 +1,10 @@
 #include "sim/body/avatar.h"
 
+#include <cctype>
 #include <cmath>
 
 #include "common/json_reader.h"
+#include "sim/body/avatar_import.h"
 #include "sim/body/parametric.h"
 
 namespace irbench {
@@ -306,18 +308,86 @@ Avatar BuildTubeAvatar(const AvatarParams& params) {
   return avatar;
 }
 
+namespace {
+
+std::string LowerExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// kind "mesh": a rigged mesh file imported with the options in the JSON
+// (docs/avatars.md, "Imported rigged meshes").
+Avatar LoadMeshAvatar(const std::filesystem::path& path, const JsonNode& root, const std::string& name,
+                      const nlohmann::json& style) {
+  for (const char* key : {"height_m", "build", "albedo", "shape"}) {
+    if (root.Has(key)) {
+      root[key].Fail("not used by imported meshes (their size comes from the file and \"scale\", "
+                     "their albedo from its materials)");
+    }
+  }
+  std::filesystem::path file = root.GetString("file");
+  if (file.is_relative()) file = path.parent_path() / file;
+  if (!std::filesystem::is_regular_file(file)) root["file"].Fail("no such file: " + file.string());
+  ImportOptions options;
+  options.name = name;
+  if (root.Has("scale")) {
+    options.scale = root.GetDouble("scale");
+    if (!(options.scale > 0 && options.scale <= 1000)) root["scale"].Fail("must be in (0, 1000] metres per file unit");
+  }
+  options.up_axis = root.GetString("up_axis", "auto");
+  if (options.up_axis != "auto" && options.up_axis != "y" && options.up_axis != "z") {
+    root["up_axis"].Fail("must be auto, y or z");
+  }
+  if (root.Has("joint_map")) {
+    const JsonNode m = root["joint_map"];
+    if (!m.raw().is_object()) m.Fail("must be an object: canonical joint name -> rig joint name");
+    for (const auto& [canonical, rig] : m.raw().items()) {
+      if (!rig.is_string()) m[canonical].Fail("must be a string (the rig's joint name, or \"\" to leave it unmapped)");
+      options.joint_map[canonical] = rig.get<std::string>();
+    }
+  }
+  Avatar avatar;
+  try {
+    avatar = ImportRiggedAvatar(file, options);
+  } catch (const InputError& e) {
+    // Option errors belong to the JSON; file, skin and height errors to the mesh.
+    if (e.field().rfind("joint_map", 0) == 0 || e.field() == "scale" || e.field() == "up_axis") {
+      throw InputError(path.string(), e.field(), e.message());
+    }
+    throw;
+  }
+  avatar.params.style = style;
+  return avatar;
+}
+
+}  // namespace
+
 Avatar LoadAvatar(const std::filesystem::path& path) {
+  const std::string ext = LowerExtension(path);
+  if (ext != ".json") {
+    // A rigged mesh file itself, imported with the default options.
+    ImportOptions options;
+    return ImportRiggedAvatar(path, options);
+  }
   const JsonNode root = ParseJsonFile(path.string());
-  root.CheckKeys({"format", "name", "description", "kind", "height_m", "build", "albedo", "style", "shape"});
+  root.CheckKeys({"format", "name", "description", "kind", "height_m", "build", "albedo", "style", "shape",
+                  "file", "scale", "up_axis", "joint_map"});
   if (root.GetString("format") != "irbench.avatar/1") root["format"].Fail("expected \"irbench.avatar/1\"");
   const std::string kind = root.GetString("kind");
-  if (kind != "tube" && kind != "parametric") root["kind"].Fail("unknown avatar kind '" + kind + "' (tube, parametric)");
+  if (kind != "tube" && kind != "parametric" && kind != "mesh") {
+    root["kind"].Fail("unknown avatar kind '" + kind + "' (tube, parametric, mesh)");
+  }
   AvatarParams params;
   params.kind = kind;
   params.name = root.GetString("name", path.stem().string());
   if (root.Has("style")) {
     if (!root["style"].raw().is_object()) root["style"].Fail("must be an object (see docs/motion.md)");
     params.style = root["style"].raw();
+  }
+  if (kind == "mesh") return LoadMeshAvatar(path, root, params.name, params.style);
+  for (const char* key : {"file", "scale", "up_axis", "joint_map"}) {
+    if (root.Has(key)) root[key].Fail("only imported (kind \"mesh\") avatars have it");
   }
   params.height_m = root.GetDouble("height_m");
   if (params.height_m < 1.0 || params.height_m > 2.3) root["height_m"].Fail("must be in 1.0..2.3 m");

@@ -30,6 +30,9 @@ struct AvatarParams {
   // How this person moves: fields of MotionStyle (docs/motion.md) that
   // override the seeded draw; checked by the motion library.
   nlohmann::json style = nullptr;
+  // Imported meshes: where the body came from and how its rig was read (file,
+  // convention, up_axis, scale, joint_map, unmapped_rig_joints).
+  nlohmann::json source = nullptr;
 };
 
 struct Avatar {

@@ -1,20 +1,14 @@
 #include "sim/body/avatar_import.h"
 
-// tinygltf is header-only; its implementation lives in this one file. The
-// Debian package has no stb headers (libstb-dev), so tinygltf's stb image
-// support is off and images are decoded by OpenCV in DecodeGltfImage.
-#define TINYGLTF_IMPLEMENTATION
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#include <tiny_gltf.h>
-
-#include <assimp/Importer.hpp>
+// tinygltf: the Debian shared library (TinyGLTF::TinyGLTF, built with stb and
+// nlohmann json), as gltf_export.cc uses it; no TINYGLTF_IMPLEMENTATION here.
+// Its stb decoder (tinygltf::LoadImageData) also decodes assimp's textures.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <tiny_gltf.h>
 
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -38,7 +32,7 @@
 //    (the Wizard's face and shoulder pads) are included with weight 1 on that
 //    joint, placed by the joint's bind transform; props are left out (a node,
 //    mesh or attachment joint named like weapon, staff, sword, shield, prop,
-//    gun, tool).
+//    gun, tool; skinned meshes too, unless there is nothing else).
 // 2. Map the rig's joints to the canonical ones by name (MapRigJoints): every
 //    table is tried and the one mapping the most joints wins. Spine and chest
 //    need not exist (they are interpolated), clavicles are optional (placed 20%
@@ -59,28 +53,33 @@
 //    the smallest rotation on top of its parent's (so the rig's twist stays):
 //    pelvis -> chest, spine -> chest, chest -> neck, neck -> head along +z;
 //    shoulder -> elbow, elbow -> wrist along +x (right) / -x (left); hip ->
-//    knee, knee -> ankle along -z. The head keeps the chest's rotation (the face
-//    keeps looking ahead when a leaning neck is straightened), clavicles the
-//    chest's, wrists (hands, fingers) the elbow's; ankles keep the file's
-//    orientation (the feet stay flat on the floor). The mesh follows by linear
+//    knee, knee -> ankle along -z. The head and the ankles keep the file's
+//    orientation (the face keeps looking ahead when a leaning neck is
+//    straightened, the feet stay flat on the floor), clavicles the chest's
+//    rotation, wrists (hands, fingers) the elbow's. The mesh follows by linear
 //    blend skinning with the collapsed weights; the skeleton's bind positions
 //    are the re-posed joints. Then the lowest vertex goes to z = 0 and the
 //    pelvis over the origin.
-// 7. Markers: "head" = centroid of the head-dominated vertices; hand tips =
+// 7. Markers: "head" = centroid of the head-dominated vertices, but not higher
+//    than halfway from the head joint to the top of those vertices; hand tips =
 //    (+-L, 0, 0) in the wrist frame, L the largest extent along the forearm
 //    direction of the hand vertices (wrist-dominated, or elbow-dominated beyond
-//    the wrist). Body radii (truth_radius): the median distance of the nearby
-//    vertices dominated by the joint or its neighbour, perpendicular to the
-//    body segment's axis, within a slab across the axis through the point
-//    (TruthRadii below lists axis, slab and joints per key); the head's is the
-//    median 3D distance of the head vertices from the head marker; with fewer
-//    than 6 vertices the tube avatar's fraction of the height; both sides'
-//    medians are averaged.
+//    the wrist). Body radii (truth_radius, how deep the point lies under the
+//    surface the cameras see): the median distance to the re-posed mesh along
+//    16 rays across the body segment from the point (waist, neck, hip, knee,
+//    ankle: horizontal; shoulder, elbow, wrist: in the y-z plane; hand tip:
+//    from 1.5% of the height behind the tip), for the head along 64 rays in
+//    all directions from the head marker; both sides averaged. A median is
+//    robust to the rays that run along the body (shoulder -> torso, hip ->
+//    other leg, head -> neck) and independent of the tessellation. When most
+//    rays miss (a point outside the mesh) the tube avatar's fraction of the
+//    height is used.
 // 8. Appearance: albedo = 0.8 x Rec. 709 luminance of the linear base colour:
 //    the material's baseColorFactor (assimp: base or diffuse colour) times the
-//    base-colour texture sampled at the vertex's UV (sRGB decoded) when it
-//    decodes; emissive 0. Normals are area-weighted over the re-posed mesh,
-//    welded by position (smooth across UV seams).
+//    base-colour texture sampled bilinearly at the vertex's UV (sRGB decoded,
+//    by tinygltf's stb decoder) when it decodes; emissive 0. Normals are
+//    area-weighted over the re-posed mesh, welded by position (smooth across
+//    UV seams).
 
 namespace irbench {
 namespace {
@@ -111,8 +110,9 @@ std::string NormaliseJointName(const std::string& name) {
   for (char& c : s) {
     if (c == '.' || c == '-' || c == ' ') c = '_';
   }
-  static const char* kPrefixes[] = {"mixamorig_", "mixamorig1_", "mixamorig2_", "armature_", "skeleton_",
-                                    "def_",       "org_",        "bip01_",      "bip001_"};
+  static const char* kPrefixes[] = {"mixamorig_", "mixamorig1_", "mixamorig2_",
+                                    "armature_",  "skeleton_",   "def_",
+                                    "org_",       "bip01_",      "bip001_"};
   for (bool again = true; again;) {
     again = false;
     for (const char* p : kPrefixes) {
@@ -140,6 +140,12 @@ struct Convention {
 const std::vector<Convention>& Conventions() {
   // Order breaks ties: the specific tables before "generic".
   static const std::vector<Convention> tables = {
+      {"irbench",  // our own glTF export (irbench avatar export): the canonical names
+       [] {
+         std::vector<std::pair<std::string, std::vector<std::string>>> entries;
+         for (int j = 0; j < kJointCount; ++j) entries.push_back({JointName(j), {JointName(j)}});
+         return entries;
+       }()},
       {"cesium",  // Cesium's sample rigs: CesiumMan, RiggedFigure (Khronos glTF samples)
        {{"pelvis", {"torso_joint_1"}},
         {"spine", {"torso_joint_2"}},
@@ -249,7 +255,9 @@ const std::vector<Convention>& Conventions() {
       {"generic",  // Blender metarig, Quaternius, 3ds Max biped (Bip01 stripped), others
        {{"pelvis", {"hips", "pelvis", "hip"}},
         {"spine", {"spine", "abdomen", "spine1", "spine_01", "spine01", "lowerback", "waist"}},
-        {"chest", {"chest", "torso", "spine2", "spine_02", "spine02", "upperchest", "upper_chest", "thorax"}},
+        {"chest",
+         {"chest", "torso", "spine2", "spine_02", "spine02", "upperchest", "upper_chest",
+          "thorax"}},
         {"neck", {"neck", "neck1", "neck_01", "neck01"}},
         {"head", {"head"}},
         {"clavicle", {"clavicle", "shoulder", "collar"}},
@@ -265,22 +273,40 @@ const std::vector<Convention>& Conventions() {
 
 const char* LimbKey(int joint) {
   switch (joint) {
-    case kRightClavicle: case kLeftClavicle: return "clavicle";
-    case kRightShoulder: case kLeftShoulder: return "shoulder";
-    case kRightElbow: case kLeftElbow: return "elbow";
-    case kRightWrist: case kLeftWrist: return "wrist";
-    case kRightHip: case kLeftHip: return "hip";
-    case kRightKnee: case kLeftKnee: return "knee";
-    case kRightAnkle: case kLeftAnkle: return "ankle";
-    default: return nullptr;
+    case kRightClavicle:
+    case kLeftClavicle:
+      return "clavicle";
+    case kRightShoulder:
+    case kLeftShoulder:
+      return "shoulder";
+    case kRightElbow:
+    case kLeftElbow:
+      return "elbow";
+    case kRightWrist:
+    case kLeftWrist:
+      return "wrist";
+    case kRightHip:
+    case kLeftHip:
+      return "hip";
+    case kRightKnee:
+    case kLeftKnee:
+      return "knee";
+    case kRightAnkle:
+    case kLeftAnkle:
+      return "ankle";
+    default:
+      return nullptr;
   }
 }
 
-bool IsLeft(int joint) { return std::string(JointName(joint)).rfind("left_", 0) == 0; }
+bool IsLeft(int joint) {
+  return std::string(JointName(joint)).rfind("left_", 0) == 0;
+}
 
 std::string Substitute(std::string s, bool left) {
-  for (const auto& [key, value] : {std::pair<std::string, std::string>{"{side}", left ? "left" : "right"},
-                                   std::pair<std::string, std::string>{"{s}", left ? "l" : "r"}}) {
+  for (const auto& [key, value] :
+       {std::pair<std::string, std::string>{"{side}", left ? "left" : "right"},
+        std::pair<std::string, std::string>{"{s}", left ? "l" : "r"}}) {
     for (size_t pos; (pos = s.find(key)) != std::string::npos;) s.replace(pos, key.size(), value);
   }
   return s;
@@ -301,7 +327,8 @@ std::vector<std::string> Candidates(const Convention& table, int joint) {
           continue;
         }
         const std::string l = left ? "l" : "r", word = left ? "left" : "right";
-        for (const std::string& form : {a + "_" + l, a + "_" + word, l + "_" + a, word + "_" + a, word + a, a + word}) {
+        for (const std::string& form :
+             {a + "_" + l, a + "_" + word, l + "_" + a, word + "_" + a, word + a, a + word}) {
           out.push_back(form);
         }
       }
@@ -310,7 +337,9 @@ std::vector<std::string> Candidates(const Convention& table, int joint) {
   return out;
 }
 
-bool IsRequired(int joint) { return joint != kSpine && joint != kChest && joint != kRightClavicle && joint != kLeftClavicle; }
+bool IsRequired(int joint) {
+  return joint != kSpine && joint != kChest && joint != kRightClavicle && joint != kLeftClavicle;
+}
 
 std::string JoinNames(const std::vector<std::string>& names, size_t limit = 60) {
   std::string out;
@@ -376,17 +405,17 @@ JointMapping MapJoints(const std::vector<std::string>& rig_names,
       }
     }
     if (found.empty()) {
-      throw InputError(file, field, "the rig has no joint named '" + rig + "' (rig joints: " + JoinNames(rig_names) + ")");
+      throw InputError(
+          file, field,
+          "the rig has no joint named '" + rig + "' (rig joints: " + JoinNames(rig_names) + ")");
     }
     for (auto it = best.map.begin(); it != best.map.end();) {  // the override takes the rig joint
       it = it->second == found && it->first != canonical ? best.map.erase(it) : std::next(it);
     }
     best.map[canonical] = found;
   }
-  if (!overrides.empty()) best.convention += best.convention == "unknown" ? "" : "+overrides";
-  if (best.convention == "unknown+overrides" || (best.convention == "unknown" && !best.map.empty())) {
-    best.convention = "custom";
-  }
+  if (!overrides.empty())
+    best.convention = best.convention == "unknown" ? "custom" : best.convention + "+overrides";
 
   std::set<std::string> mapped;
   for (const auto& [canonical, rig] : best.map) mapped.insert(rig);
@@ -400,18 +429,20 @@ JointMapping MapJoints(const std::vector<std::string>& rig_names,
 // The loaded rig, in the file's world frame and units.
 
 struct Texture {
-  cv::Mat linear;  // CV_32FC3, linear RGB, row 0 at the top
+  int width = 0, height = 0;
+  std::vector<Eigen::Vector3f> linear;  // linear RGB, row 0 at the top
+  bool empty() const { return linear.empty(); }
 };
 
 struct Rig {
   std::vector<std::string> joint_name;
-  std::vector<int> joint_parent;           // nearest ancestor that is a joint; -1
-  std::vector<Vector3d> joint_bind;        // bind position
-  std::vector<Vector3d> position;          // vertices, bind pose
-  std::vector<float> albedo;               // per vertex
+  std::vector<int> joint_parent;     // nearest ancestor that is a joint; -1
+  std::vector<Vector3d> joint_bind;  // bind position
+  std::vector<Vector3d> position;    // vertices, bind pose
+  std::vector<float> albedo;         // per vertex
   std::vector<uint32_t> indices;
   std::vector<std::vector<std::pair<int, float>>> influence;  // rig joint, weight
-  double unit_scale = 1.0;  // metres per unit
+  double unit_scale = 1.0;                                    // metres per unit
   bool unit_known = false;
   std::string format;
 };
@@ -424,46 +455,55 @@ bool IsProp(const std::string& name) {
   return false;
 }
 
-float SrgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+float SrgbToLinear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
 
-// 8-bit BGR(A) or grey OpenCV image -> linear RGB float.
-Texture MakeTexture(const cv::Mat& image) {
+// A decoded tinygltf image (1..4 components, 8 or 16 bits, sRGB) -> linear RGB.
+Texture MakeTexture(const tinygltf::Image& image) {
   Texture t;
-  if (image.empty() || image.depth() != CV_8U) return t;
-  cv::Mat bgr;
-  if (image.channels() == 1) {
-    cv::Mat channels[] = {image, image, image};
-    cv::merge(channels, 3, bgr);
-  } else if (image.channels() == 4) {
-    cv::Mat channels[4];
-    cv::split(image, channels);
-    cv::merge(channels, 3, bgr);
-  } else {
-    bgr = image;
+  const int comp = image.component, bytes = image.bits / 8;
+  if (image.width < 1 || image.height < 1 || comp < 1 || comp > 4 || (bytes != 1 && bytes != 2) ||
+      image.image.size() < static_cast<size_t>(image.width) * image.height * comp * bytes) {
+    return t;
   }
-  float lut[256];
-  for (int i = 0; i < 256; ++i) lut[i] = SrgbToLinear(i / 255.0f);
-  t.linear.create(bgr.rows, bgr.cols, CV_32FC3);
-  for (int r = 0; r < bgr.rows; ++r) {
-    for (int c = 0; c < bgr.cols; ++c) {
-      const cv::Vec3b p = bgr.at<cv::Vec3b>(r, c);
-      t.linear.at<cv::Vec3f>(r, c) = cv::Vec3f(lut[p[2]], lut[p[1]], lut[p[0]]);
-    }
+  t.width = image.width;
+  t.height = image.height;
+  t.linear.resize(static_cast<size_t>(t.width) * t.height);
+  std::vector<float> lut(bytes == 1 ? 256 : 65536);
+  for (size_t i = 0; i < lut.size(); ++i)
+    lut[i] = SrgbToLinear(static_cast<float>(i) / (lut.size() - 1));
+  for (size_t p = 0; p < t.linear.size(); ++p) {
+    auto channel = [&](int c) {
+      const unsigned char* q = &image.image[(p * comp + c) * bytes];
+      return bytes == 1 ? lut[*q] : lut[q[0] | (q[1] << 8)];
+    };
+    const float r = channel(0);
+    t.linear[p] = comp >= 3 ? Eigen::Vector3f(r, channel(1), channel(2)) : Eigen::Vector3f(r, r, r);
   }
   return t;
 }
 
+// Decodes PNG/JPEG bytes with tinygltf's stb decoder; empty when it cannot.
+Texture DecodeTexture(const unsigned char* bytes, int size) {
+  tinygltf::Image image;
+  std::string err, warn;
+  if (size <= 0 || !tinygltf::LoadImageData(&image, 0, &err, &warn, 0, 0, bytes, size, nullptr))
+    return {};
+  return MakeTexture(image);
+}
+
 // Bilinear, repeating; (u, v) with v = 0 at the top row.
 Eigen::Vector3f Sample(const Texture& t, double u, double v) {
-  const int w = t.linear.cols, h = t.linear.rows;
+  const int w = t.width, h = t.height;
   const double x = (u - std::floor(u)) * w - 0.5, y = (v - std::floor(v)) * h - 0.5;
   const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
   const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
   auto at = [&](int xi, int yi) {
-    const cv::Vec3f p = t.linear.at<cv::Vec3f>(((yi % h) + h) % h, ((xi % w) + w) % w);
-    return Eigen::Vector3f(p[0], p[1], p[2]);
+    return t.linear[static_cast<size_t>(((yi % h) + h) % h) * w + ((xi % w) + w) % w];
   };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) + fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+         fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
 }
 
 float AlbedoOf(const Eigen::Vector3f& linear_rgb) {
@@ -474,32 +514,24 @@ float AlbedoOf(const Eigen::Vector3f& linear_rgb) {
 // ---------------------------------------------------------------------------
 // glTF.
 
-// tinygltf image callback: decodes PNG/JPEG with OpenCV into 8-bit RGB. A
-// texture that does not decode is left empty (the material colour is used).
-bool DecodeGltfImage(tinygltf::Image* image, const int, std::string*, std::string* warn, int, int,
-                     const unsigned char* bytes, int size, void*) {
-  cv::Mat decoded;
-  try {
-    decoded = cv::imdecode(cv::Mat(1, size, CV_8U, const_cast<unsigned char*>(bytes)), cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    decoded.release();
-  }
-  if (decoded.empty() || decoded.depth() != CV_8U) {
-    if (warn) *warn += "image '" + image->name + "' does not decode; using the material colour\n";
-    return true;
-  }
-  image->width = decoded.cols;
-  image->height = decoded.rows;
-  image->component = 3;
-  image->bits = 8;
-  image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
-  image->image.resize(static_cast<size_t>(decoded.cols) * decoded.rows * 3);
-  for (int r = 0; r < decoded.rows; ++r) {
-    for (int c = 0; c < decoded.cols; ++c) {
-      const cv::Vec3b p = decoded.at<cv::Vec3b>(r, c);
-      unsigned char* out = &image->image[(static_cast<size_t>(r) * decoded.cols + c) * 3];
-      out[0] = p[2], out[1] = p[1], out[2] = p[0];
-    }
+// tinygltf image callback: its own stb decoder, but a texture that does not
+// decode leaves the image empty (the material colour is used) instead of
+// failing the whole file.
+bool DecodeGltfImage(tinygltf::Image* image,
+                     const int index,
+                     std::string*,
+                     std::string* warn,
+                     int width,
+                     int height,
+                     const unsigned char* bytes,
+                     int size,
+                     void*) {
+  std::string err;
+  if (!tinygltf::LoadImageData(image, index, &err, warn, width, height, bytes, size, nullptr)) {
+    if (warn)
+      *warn +=
+          "image '" + image->name + "' does not decode (" + err + "); using the material colour\n";
+    image->image.clear();
   }
   return true;
 }
@@ -511,24 +543,33 @@ class GltfReader {
   // Accessor `index` as doubles, `components` per element (checked); integer
   // components are scaled to [0, 1] when the accessor is normalised or
   // `normalise` is set (glTF weights), else read as integers.
-  std::vector<double> Read(int index, int components, const std::string& what, bool normalise = false) const {
-    if (index < 0 || index >= static_cast<int>(m_.accessors.size())) Fail(what + ": no accessor " + std::to_string(index));
+  std::vector<double> Read(int index,
+                           int components,
+                           const std::string& what,
+                           bool normalise = false) const {
+    if (index < 0 || index >= static_cast<int>(m_.accessors.size()))
+      Fail(what + ": no accessor " + std::to_string(index));
     const tinygltf::Accessor& a = m_.accessors[index];
     if (a.sparse.isSparse) Fail(what + ": sparse accessors are not supported");
     const int n = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type));
-    if (n != components) Fail(what + ": expected " + std::to_string(components) + " components, got " + std::to_string(n));
+    if (n != components)
+      Fail(what + ": expected " + std::to_string(components) + " components, got " +
+           std::to_string(n));
     const int size = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType));
     if (size <= 0) Fail(what + ": bad component type " + std::to_string(a.componentType));
     std::vector<double> out(a.count * static_cast<size_t>(n), 0.0);
     if (a.bufferView < 0) return out;  // all zeros by the specification
     if (a.bufferView >= static_cast<int>(m_.bufferViews.size())) Fail(what + ": bad buffer view");
     const tinygltf::BufferView& view = m_.bufferViews[a.bufferView];
-    if (view.buffer < 0 || view.buffer >= static_cast<int>(m_.buffers.size())) Fail(what + ": bad buffer");
+    if (view.buffer < 0 || view.buffer >= static_cast<int>(m_.buffers.size()))
+      Fail(what + ": bad buffer");
     const std::vector<unsigned char>& data = m_.buffers[view.buffer].data;
     const int stride = a.ByteStride(view);
     if (stride <= 0) Fail(what + ": bad byte stride");
     const size_t begin = view.byteOffset + a.byteOffset;
-    const size_t end_needed = a.count == 0 ? begin : begin + static_cast<size_t>(stride) * (a.count - 1) + size_t(n) * size;
+    const size_t end_needed =
+        a.count == 0 ? begin
+                     : begin + static_cast<size_t>(stride) * (a.count - 1) + size_t(n) * size;
     if (end_needed > view.byteOffset + view.byteLength || end_needed > data.size()) {
       Fail(what + ": accessor " + std::to_string(index) + " runs past its buffer");
     }
@@ -539,15 +580,54 @@ class GltfReader {
         const unsigned char* q = p + c * size;
         double v = 0;
         switch (a.componentType) {
-          case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, q, 4); v = f; break; }
-          case TINYGLTF_COMPONENT_TYPE_DOUBLE: { double d; std::memcpy(&d, q, 8); v = d; break; }
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *q; if (scale) v /= 255.0; break;
-          case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t i; std::memcpy(&i, q, 1); v = scale ? std::max(i / 127.0, -1.0) : i; break; }
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t i; std::memcpy(&i, q, 2); v = scale ? i / 65535.0 : i; break; }
-          case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t i; std::memcpy(&i, q, 2); v = scale ? std::max(i / 32767.0, -1.0) : i; break; }
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t i; std::memcpy(&i, q, 4); v = scale ? i / 4294967295.0 : i; break; }
-          case TINYGLTF_COMPONENT_TYPE_INT: { int32_t i; std::memcpy(&i, q, 4); v = i; break; }
-          default: Fail(what + ": bad component type");
+          case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+            float f;
+            std::memcpy(&f, q, 4);
+            v = f;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_DOUBLE: {
+            double d;
+            std::memcpy(&d, q, 8);
+            v = d;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            v = *q;
+            if (scale) v /= 255.0;
+            break;
+          case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            int8_t i;
+            std::memcpy(&i, q, 1);
+            v = scale ? std::max(i / 127.0, -1.0) : i;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t i;
+            std::memcpy(&i, q, 2);
+            v = scale ? i / 65535.0 : i;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            int16_t i;
+            std::memcpy(&i, q, 2);
+            v = scale ? std::max(i / 32767.0, -1.0) : i;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+            uint32_t i;
+            std::memcpy(&i, q, 4);
+            v = scale ? i / 4294967295.0 : i;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_INT: {
+            int32_t i;
+            std::memcpy(&i, q, 4);
+            v = i;
+            break;
+          }
+          default:
+            Fail(what + ": bad component type");
         }
         out[k * n + c] = v;
       }
@@ -555,7 +635,9 @@ class GltfReader {
     return out;
   }
 
-  [[noreturn]] void Fail(const std::string& message) const { throw InputError(file_, "file", message); }
+  [[noreturn]] void Fail(const std::string& message) const {
+    throw InputError(file_, "file", message);
+  }
 
  private:
   const tinygltf::Model& m_;
@@ -568,19 +650,24 @@ Matrix4d NodeLocal(const tinygltf::Node& node) {
     for (int i = 0; i < 16; ++i) m(i % 4, i / 4) = node.matrix[i];
     return m;
   }
-  const Vector3d t = node.translation.size() == 3 ? Vector3d(node.translation[0], node.translation[1], node.translation[2])
-                                                  : Vector3d::Zero();
+  const Vector3d t = node.translation.size() == 3
+                         ? Vector3d(node.translation[0], node.translation[1], node.translation[2])
+                         : Vector3d::Zero();
   Eigen::Quaterniond q = node.rotation.size() == 4
-                             ? Eigen::Quaterniond(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2])
+                             ? Eigen::Quaterniond(node.rotation[3], node.rotation[0],
+                                                  node.rotation[1], node.rotation[2])
                              : Eigen::Quaterniond::Identity();
   if (q.norm() > 0) q.normalize();
-  const Vector3d s = node.scale.size() == 3 ? Vector3d(node.scale[0], node.scale[1], node.scale[2]) : Vector3d::Ones();
+  const Vector3d s = node.scale.size() == 3 ? Vector3d(node.scale[0], node.scale[1], node.scale[2])
+                                            : Vector3d::Ones();
   m.block<3, 3>(0, 0) = q.toRotationMatrix() * s.asDiagonal();
   m.block<3, 1>(0, 3) = t;
   return m;
 }
 
-Vector3d Apply(const Matrix4d& m, const Vector3d& p) { return m.block<3, 3>(0, 0) * p + m.block<3, 1>(0, 3); }
+Vector3d Apply(const Matrix4d& m, const Vector3d& p) {
+  return m.block<3, 3>(0, 0) * p + m.block<3, 1>(0, 3);
+}
 
 Rig LoadGltf(const fs::path& path) {
   const std::string file = path.string();
@@ -605,19 +692,24 @@ Rig LoadGltf(const fs::path& path) {
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
     return s;
   };
-  if (!ok) throw InputError(file, "file", "not a readable glTF file: " + (err.empty() ? std::string("unknown error") : trim(err)));
+  if (!ok)
+    throw InputError(
+        file, "file",
+        "not a readable glTF file: " + (err.empty() ? std::string("unknown error") : trim(err)));
   if (!warn.empty()) Log().debug("avatar import: {}: {}", file, trim(warn));
 
   const GltfReader reader(model, file);
   const int node_count = static_cast<int>(model.nodes.size());
-  if (model.skins.empty()) throw InputError(file, "skin", "no skin: the file has no rigged (skinned) mesh");
+  if (model.skins.empty())
+    throw InputError(file, "skin", "no skin: the file has no rigged (skinned) mesh");
   const tinygltf::Skin& skin = model.skins[0];
   if (skin.joints.empty()) throw InputError(file, "skin", "skin 0 has no joints");
 
   std::vector<int> parent(node_count, -1);
   for (int i = 0; i < node_count; ++i) {
     for (int c : model.nodes[i].children) {
-      if (c < 0 || c >= node_count || parent[c] >= 0 || c == i) reader.Fail("node " + std::to_string(i) + ": bad child " + std::to_string(c));
+      if (c < 0 || c >= node_count || parent[c] >= 0 || c == i)
+        reader.Fail("node " + std::to_string(i) + ": bad child " + std::to_string(c));
       parent[c] = i;
     }
   }
@@ -627,7 +719,8 @@ Rig LoadGltf(const fs::path& path) {
     if (state[i] == 1) reader.Fail("the node hierarchy has a cycle");
     if (state[i] == 0) {
       state[i] = 1;
-      world[i] = parent[i] >= 0 ? Matrix4d(world_of(parent[i]) * NodeLocal(model.nodes[i])) : NodeLocal(model.nodes[i]);
+      world[i] = parent[i] >= 0 ? Matrix4d(world_of(parent[i]) * NodeLocal(model.nodes[i]))
+                                : NodeLocal(model.nodes[i]);
       state[i] = 2;
     }
     return world[i];
@@ -641,21 +734,29 @@ Rig LoadGltf(const fs::path& path) {
   std::vector<int> joint_of_node(node_count, -1);
   for (int k = 0; k < joint_count; ++k) {
     const int node = skin.joints[k];
-    if (node < 0 || node >= node_count) reader.Fail("skin 0: bad joint node " + std::to_string(node));
+    if (node < 0 || node >= node_count)
+      reader.Fail("skin 0: bad joint node " + std::to_string(node));
     joint_of_node[node] = k;
   }
   std::vector<Matrix4d> inverse_bind(joint_count, Matrix4d::Identity());
   if (skin.inverseBindMatrices >= 0) {
-    const std::vector<double> m = reader.Read(skin.inverseBindMatrices, 16, "skin 0 inverseBindMatrices");
-    if (m.size() < size_t(16) * joint_count) reader.Fail("skin 0: fewer inverse bind matrices than joints");
+    const std::vector<double> m =
+        reader.Read(skin.inverseBindMatrices, 16, "skin 0 inverseBindMatrices");
+    if (m.size() < size_t(16) * joint_count)
+      reader.Fail("skin 0: fewer inverse bind matrices than joints");
     for (int k = 0; k < joint_count; ++k) {
       for (int i = 0; i < 16; ++i) inverse_bind[k](i % 4, i / 4) = m[16 * k + i];
     }
   }
-  std::vector<int> skinned_nodes;
+  std::vector<int> skinned_nodes, skinned_props;
   for (int i = 0; i < node_count; ++i) {
-    if (model.nodes[i].skin == 0 && model.nodes[i].mesh >= 0) skinned_nodes.push_back(i);
+    const tinygltf::Node& node = model.nodes[i];
+    if (node.skin != 0 || node.mesh < 0) continue;
+    const bool prop = IsProp(node.name) || (node.mesh < static_cast<int>(model.meshes.size()) &&
+                                            IsProp(model.meshes[node.mesh].name));
+    (prop ? skinned_props : skinned_nodes).push_back(i);
   }
+  if (skinned_nodes.empty()) skinned_nodes = skinned_props;  // only props: take them
   if (skinned_nodes.empty()) throw InputError(file, "skin", "no mesh node uses skin 0");
   const Matrix4d skin_world = world_of(skinned_nodes[0]);
 
@@ -666,7 +767,8 @@ Rig LoadGltf(const fs::path& path) {
     int p = parent[skin.joints[k]];
     while (p >= 0 && joint_of_node[p] < 0) p = parent[p];
     rig.joint_parent.push_back(p >= 0 ? joint_of_node[p] : -1);
-    if (std::abs(inverse_bind[k].determinant()) < 1e-12) reader.Fail("skin 0: singular inverse bind matrix of joint '" + rig.joint_name.back() + "'");
+    if (std::abs(inverse_bind[k].determinant()) < 1e-12)
+      reader.Fail("skin 0: singular inverse bind matrix of joint '" + rig.joint_name.back() + "'");
     bind[k] = skin_world * inverse_bind[k].inverse();
     rig.joint_bind.push_back(bind[k].block<3, 1>(0, 3));
   }
@@ -674,37 +776,29 @@ Rig LoadGltf(const fs::path& path) {
   // Textures decoded once per image.
   std::map<int, Texture> textures;
   auto texture_of = [&](int texture_index) -> const Texture* {
-    if (texture_index < 0 || texture_index >= static_cast<int>(model.textures.size())) return nullptr;
+    if (texture_index < 0 || texture_index >= static_cast<int>(model.textures.size()))
+      return nullptr;
     const int source = model.textures[texture_index].source;
     if (source < 0 || source >= static_cast<int>(model.images.size())) return nullptr;
     auto it = textures.find(source);
     if (it == textures.end()) {
-      const tinygltf::Image& image = model.images[source];
-      Texture t;
-      if (image.component == 3 && image.bits == 8 &&
-          image.image.size() == static_cast<size_t>(image.width) * image.height * 3) {
-        cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<unsigned char*>(image.image.data()));
-        cv::Mat bgr;
-        cv::Mat channels[3];
-        cv::split(rgb, channels);
-        std::swap(channels[0], channels[2]);
-        cv::merge(channels, 3, bgr);
-        t = MakeTexture(bgr);
-      }
+      Texture t = MakeTexture(model.images[source]);
       it = textures.emplace(source, std::move(t)).first;
     }
-    return it->second.linear.empty() ? nullptr : &it->second;
+    return it->second.empty() ? nullptr : &it->second;
   };
 
   // Appends one mesh; `rigid_joint` >= 0: all its vertices on that joint.
   auto add_mesh = [&](int mesh_index, const Matrix4d& transform, int rigid_joint) {
-    if (mesh_index < 0 || mesh_index >= static_cast<int>(model.meshes.size())) reader.Fail("bad mesh index");
+    if (mesh_index < 0 || mesh_index >= static_cast<int>(model.meshes.size()))
+      reader.Fail("bad mesh index");
     const tinygltf::Mesh& mesh = model.meshes[mesh_index];
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const tinygltf::Primitive& prim = mesh.primitives[pi];
       const std::string what = "mesh '" + mesh.name + "' primitive " + std::to_string(pi);
       if (prim.mode != TINYGLTF_MODE_TRIANGLES) {
-        Log().debug("avatar import: {}: {} is not TRIANGLES (mode {}), skipped", file, what, prim.mode);
+        Log().debug("avatar import: {}: {} is not TRIANGLES (mode {}), skipped", file, what,
+                    prim.mode);
         continue;
       }
       const auto pos_it = prim.attributes.find("POSITION");
@@ -721,21 +815,26 @@ Rig LoadGltf(const fs::path& path) {
           const auto j_it = prim.attributes.find("JOINTS_" + std::to_string(set));
           const auto w_it = prim.attributes.find("WEIGHTS_" + std::to_string(set));
           if (j_it == prim.attributes.end() || w_it == prim.attributes.end()) break;
-          const std::vector<double> joints = reader.Read(j_it->second, 4, what + " JOINTS_" + std::to_string(set));
-          const std::vector<double> weights = reader.Read(w_it->second, 4, what + " WEIGHTS_" + std::to_string(set), true);
-          if (joints.size() != 4 * n || weights.size() != 4 * n) reader.Fail(what + ": JOINTS/WEIGHTS count differs from POSITION");
+          const std::vector<double> joints =
+              reader.Read(j_it->second, 4, what + " JOINTS_" + std::to_string(set));
+          const std::vector<double> weights =
+              reader.Read(w_it->second, 4, what + " WEIGHTS_" + std::to_string(set), true);
+          if (joints.size() != 4 * n || weights.size() != 4 * n)
+            reader.Fail(what + ": JOINTS/WEIGHTS count differs from POSITION");
           for (size_t v = 0; v < n; ++v) {
             for (int c = 0; c < 4; ++c) {
               const double w = weights[4 * v + c];
               if (!(w > 0)) continue;
               const double j = joints[4 * v + c];
-              if (j < 0 || j >= joint_count) reader.Fail(what + ": joint index " + std::to_string(int(j)) + " out of range");
+              if (j < 0 || j >= joint_count)
+                reader.Fail(what + ": joint index " + std::to_string(int(j)) + " out of range");
               influence[v].push_back({static_cast<int>(j), static_cast<float>(w)});
             }
           }
           any = true;
         }
-        if (!any) throw InputError(file, "skin", what + " of the skinned mesh has no JOINTS_0/WEIGHTS_0");
+        if (!any)
+          throw InputError(file, "skin", what + " of the skinned mesh has no JOINTS_0/WEIGHTS_0");
       }
       // Colour: baseColorFactor x texture.
       Eigen::Vector3f factor(1, 1, 1);
@@ -743,31 +842,39 @@ Rig LoadGltf(const fs::path& path) {
       std::vector<double> uv;
       if (prim.material >= 0 && prim.material < static_cast<int>(model.materials.size())) {
         const auto& pbr = model.materials[prim.material].pbrMetallicRoughness;
-        if (pbr.baseColorFactor.size() >= 3) factor = Eigen::Vector3f(pbr.baseColorFactor[0], pbr.baseColorFactor[1], pbr.baseColorFactor[2]);
+        if (pbr.baseColorFactor.size() >= 3)
+          factor = Eigen::Vector3f(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
+                                   pbr.baseColorFactor[2]);
         texture = texture_of(pbr.baseColorTexture.index);
-        const auto uv_it = prim.attributes.find("TEXCOORD_" + std::to_string(std::max(0, pbr.baseColorTexture.texCoord)));
+        const auto uv_it = prim.attributes.find(
+            "TEXCOORD_" + std::to_string(std::max(0, pbr.baseColorTexture.texCoord)));
         if (texture && uv_it != prim.attributes.end()) {
           uv = reader.Read(uv_it->second, 2, what + " TEXCOORD", true);
           if (uv.size() != 2 * n) uv.clear();
         }
       }
       for (size_t v = 0; v < n; ++v) {
-        rig.position.push_back(Apply(transform, Vector3d(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2])));
+        rig.position.push_back(
+            Apply(transform, Vector3d(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2])));
         Eigen::Vector3f colour = factor;
         if (!uv.empty()) colour = colour.cwiseProduct(Sample(*texture, uv[2 * v], uv[2 * v + 1]));
         rig.albedo.push_back(AlbedoOf(colour));
         rig.influence.push_back(std::move(influence[v]));
       }
+      std::vector<double> idx;
       if (prim.indices >= 0) {
-        const std::vector<double> idx = reader.Read(prim.indices, 1, what + " indices");
+        idx = reader.Read(prim.indices, 1, what + " indices");
         if (idx.size() % 3) reader.Fail(what + ": index count is not a multiple of 3");
-        for (double i : idx) {
+      } else {
+        for (size_t i = 0; i < n - n % 3; ++i) idx.push_back(static_cast<double>(i));
+      }
+      // A mirroring transform reverses the winding (glTF 3.7.4).
+      const bool flip = transform.block<3, 3>(0, 0).determinant() < 0;
+      for (size_t t = 0; t < idx.size(); t += 3) {
+        for (int k : {0, flip ? 2 : 1, flip ? 1 : 2}) {
+          const double i = idx[t + k];
           if (i < 0 || i >= n) reader.Fail(what + ": vertex index out of range");
           rig.indices.push_back(base + static_cast<uint32_t>(i));
-        }
-      } else {
-        for (size_t i = 0; i + 2 < n; i += 3) {
-          for (size_t k = 0; k < 3; ++k) rig.indices.push_back(base + static_cast<uint32_t>(i + k));
         }
       }
     }
@@ -778,7 +885,8 @@ Rig LoadGltf(const fs::path& path) {
   for (int i = 0; i < node_count; ++i) {
     const tinygltf::Node& node = model.nodes[i];
     if (node.mesh < 0 || node.skin >= 0) continue;
-    bool prop = IsProp(node.name) || (node.mesh < static_cast<int>(model.meshes.size()) && IsProp(model.meshes[node.mesh].name));
+    bool prop = IsProp(node.name) || (node.mesh < static_cast<int>(model.meshes.size()) &&
+                                      IsProp(model.meshes[node.mesh].name));
     int a = parent[i];
     while (a >= 0 && joint_of_node[a] < 0) {
       prop = prop || IsProp(model.nodes[a].name);
@@ -787,7 +895,8 @@ Rig LoadGltf(const fs::path& path) {
     if (a < 0) continue;
     const int joint = joint_of_node[a];
     if (prop || IsProp(rig.joint_name[joint])) {
-      Log().debug("avatar import: {}: prop mesh '{}' on '{}' left out", file, node.name, rig.joint_name[joint]);
+      Log().debug("avatar import: {}: prop mesh '{}' on '{}' left out", file, node.name,
+                  rig.joint_name[joint]);
       continue;
     }
     add_mesh(node.mesh, Matrix4d(bind[joint] * world_of(a).inverse() * world_of(i)), joint);
@@ -800,7 +909,8 @@ Rig LoadGltf(const fs::path& path) {
 
 Matrix4d ToEigen(const aiMatrix4x4& m) {
   Matrix4d out;
-  out << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  out << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3,
+      m.d4;
   return out;
 }
 
@@ -813,10 +923,11 @@ Matrix4d NodeWorld(const aiNode* node) {
 Rig LoadAssimp(const fs::path& path) {
   const std::string file = path.string();
   Assimp::Importer importer;
-  const aiScene* scene =
-      importer.ReadFile(file, aiProcess_Triangulate | aiProcess_LimitBoneWeights | aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = importer.ReadFile(
+      file, aiProcess_Triangulate | aiProcess_LimitBoneWeights | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || scene->mRootNode == nullptr) {
-    throw InputError(file, "file", std::string("not a readable model: ") + importer.GetErrorString());
+    throw InputError(file, "file",
+                     std::string("not a readable model: ") + importer.GetErrorString());
   }
   std::string ext = Lower(path.extension().string());
   Rig rig;
@@ -860,12 +971,14 @@ Rig LoadAssimp(const fs::path& path) {
       const aiNode* bone_node = scene->mRootNode->FindNode(bone->mName);
       if (bone_node == nullptr) throw InputError(file, "skin", "bone '" + name + "' has no node");
       const Matrix4d offset = ToEigen(bone->mOffsetMatrix);
-      if (std::abs(offset.determinant()) < 1e-12) throw InputError(file, "skin", "bone '" + name + "' has a singular offset matrix");
+      if (std::abs(offset.determinant()) < 1e-12)
+        throw InputError(file, "skin", "bone '" + name + "' has a singular offset matrix");
       bone_bind[name] = NodeWorld(node) * offset.inverse();
       bone_nodes.push_back(bone_node);
     }
   }
-  if (bone_nodes.empty()) throw InputError(file, "skin", "no skin: no mesh has bones (a rigged character is needed)");
+  if (bone_nodes.empty())
+    throw InputError(file, "skin", "no skin: no mesh has bones (a rigged character is needed)");
 
   // Joints: the bones and the other plain nodes under their common ancestor.
   auto path_of = [](const aiNode* n) {
@@ -887,7 +1000,8 @@ Rig LoadAssimp(const fs::path& path) {
   std::vector<const aiNode*> joints;
   std::function<void(const aiNode*)> collect = [&](const aiNode* n) {
     const std::string name = n->mName.C_Str();
-    if (is_bone.count(n) || (n->mNumMeshes == 0 && name.find("$AssimpFbx$") == std::string::npos && !name.empty())) {
+    if (is_bone.count(n) ||
+        (n->mNumMeshes == 0 && name.find("$AssimpFbx$") == std::string::npos && !name.empty())) {
       joint_of[n] = static_cast<int>(joints.size());
       joints.push_back(n);
     }
@@ -932,27 +1046,30 @@ Rig LoadAssimp(const fs::path& path) {
     const std::string key = tex_path.C_Str();
     auto it = textures.find(key);
     if (it == textures.end()) {
-      cv::Mat image;
-      try {
-        if (const aiTexture* embedded = scene->GetEmbeddedTexture(key.c_str())) {
-          if (embedded->mHeight == 0) {
-            image = cv::imdecode(cv::Mat(1, static_cast<int>(embedded->mWidth), CV_8U,
-                                         reinterpret_cast<unsigned char*>(embedded->pcData)),
-                                 cv::IMREAD_COLOR);
-          } else {
-            cv::Mat bgra(static_cast<int>(embedded->mHeight), static_cast<int>(embedded->mWidth), CV_8UC4,
-                         reinterpret_cast<unsigned char*>(embedded->pcData));
-            image = bgra.clone();
+      Texture t;
+      if (const aiTexture* embedded = scene->GetEmbeddedTexture(key.c_str())) {
+        if (embedded->mHeight == 0) {  // compressed (PNG, JPEG): mWidth bytes
+          t = DecodeTexture(reinterpret_cast<const unsigned char*>(embedded->pcData),
+                            static_cast<int>(embedded->mWidth));
+        } else {  // raw BGRA texels
+          t.width = static_cast<int>(embedded->mWidth);
+          t.height = static_cast<int>(embedded->mHeight);
+          for (size_t p = 0; p < size_t(t.width) * t.height; ++p) {
+            const aiTexel& x = embedded->pcData[p];
+            t.linear.emplace_back(SrgbToLinear(x.r / 255.0f), SrgbToLinear(x.g / 255.0f),
+                                  SrgbToLinear(x.b / 255.0f));
           }
-        } else {
-          image = cv::imread((path.parent_path() / key).string(), cv::IMREAD_COLOR);
         }
-      } catch (const cv::Exception&) {
-        image.release();
+      } else {
+        std::ifstream in(path.parent_path() / key, std::ios::binary);
+        const std::string bytes((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
+        t = DecodeTexture(reinterpret_cast<const unsigned char*>(bytes.data()),
+                          static_cast<int>(bytes.size()));
       }
-      it = textures.emplace(key, MakeTexture(image)).first;
+      it = textures.emplace(key, std::move(t)).first;
     }
-    return it->second.linear.empty() ? nullptr : &it->second;
+    return it->second.empty() ? nullptr : &it->second;
   };
 
   auto add_mesh = [&](const aiMesh* mesh, const Matrix4d& transform, int rigid_joint) {
@@ -967,7 +1084,8 @@ Rig LoadAssimp(const fs::path& path) {
         const int joint = joint_of.at(scene->mRootNode->FindNode(bone->mName));
         for (unsigned w = 0; w < bone->mNumWeights; ++w) {
           const aiVertexWeight& vw = bone->mWeights[w];
-          if (vw.mVertexId < n && vw.mWeight > 0) influence[vw.mVertexId].push_back({joint, vw.mWeight});
+          if (vw.mVertexId < n && vw.mWeight > 0)
+            influence[vw.mVertexId].push_back({joint, vw.mWeight});
         }
       }
     }
@@ -976,7 +1094,8 @@ Rig LoadAssimp(const fs::path& path) {
     if (mesh->mMaterialIndex < scene->mNumMaterials) {
       const aiMaterial* material = scene->mMaterials[mesh->mMaterialIndex];
       aiColor4D c;
-      if (material->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS || material->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS) {
+      if (material->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS ||
+          material->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS) {
         factor = Eigen::Vector3f(c.r, c.g, c.b);
       }
       if (mesh->mTextureCoords[0] != nullptr) texture = texture_of(material);
@@ -992,19 +1111,29 @@ Rig LoadAssimp(const fs::path& path) {
       rig.albedo.push_back(AlbedoOf(colour));
       rig.influence.push_back(std::move(influence[v]));
     }
+    const bool flip =
+        transform.block<3, 3>(0, 0).determinant() < 0;  // mirrored: reverse the winding
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
-      for (int k = 0; k < 3; ++k) {
+      for (int k : {0, flip ? 2 : 1, flip ? 1 : 2}) {
         if (face.mIndices[k] >= n) throw InputError(file, "file", "vertex index out of range");
         rig.indices.push_back(base + face.mIndices[k]);
       }
     }
   };
+  const bool all_skinned_are_props =
+      std::all_of(instances.begin(), instances.end(), [&](const auto& instance) {
+        const aiMesh* mesh = scene->mMeshes[instance.first];
+        return mesh->mNumBones == 0 || IsProp(instance.second->mName.C_Str()) ||
+               IsProp(mesh->mName.C_Str());
+      });
   for (const auto& [mesh_index, node] : instances) {
     const aiMesh* mesh = scene->mMeshes[mesh_index];
     if (mesh->mNumBones > 0) {
-      add_mesh(mesh, NodeWorld(node), -1);
+      if (all_skinned_are_props || !(IsProp(node->mName.C_Str()) || IsProp(mesh->mName.C_Str()))) {
+        add_mesh(mesh, NodeWorld(node), -1);
+      }
       continue;
     }
     // Rigid meshes under a joint.
@@ -1032,10 +1161,11 @@ std::string JoinCanonical(const std::vector<int>& joints) {
 }
 
 int Mirror(int joint) {
-  static const int kMirror[kJointCount] = {kPelvis,       kSpine,        kChest,         kNeck,          kHead,
-                                           kLeftClavicle, kLeftShoulder, kLeftElbow,     kLeftWrist,     kRightClavicle,
-                                           kRightShoulder, kRightElbow,  kRightWrist,    kLeftHip,       kLeftKnee,
-                                           kLeftAnkle,    kRightHip,     kRightKnee,     kRightAnkle};
+  static const int kMirror[kJointCount] = {kPelvis,     kSpine,         kChest,         kNeck,
+                                           kHead,       kLeftClavicle,  kLeftShoulder,  kLeftElbow,
+                                           kLeftWrist,  kRightClavicle, kRightShoulder, kRightElbow,
+                                           kRightWrist, kLeftHip,       kLeftKnee,      kLeftAnkle,
+                                           kRightHip,   kRightKnee,     kRightAnkle};
   return kMirror[joint];
 }
 
@@ -1043,6 +1173,30 @@ double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Distance along the unit ray (o, d) to the nearest triangle; infinity if none.
+double RayHit(const std::vector<Vector3d>& verts,
+              const std::vector<uint32_t>& indices,
+              const Vector3d& o,
+              const Vector3d& d) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {  // Moller-Trumbore
+    const Vector3d& a = verts[indices[t]];
+    const Vector3d e1 = verts[indices[t + 1]] - a, e2 = verts[indices[t + 2]] - a;
+    const Vector3d p = d.cross(e2);
+    const double det = e1.dot(p);
+    if (std::abs(det) < 1e-14) continue;
+    const Vector3d s = o - a;
+    const double u = s.dot(p) / det;
+    if (u < 0 || u > 1) continue;
+    const Vector3d qv = s.cross(e1);
+    const double v = d.dot(qv) / det;
+    if (v < 0 || u + v > 1) continue;
+    const double dist = e2.dot(qv) / det;
+    if (dist > 1e-9 && dist < best) best = dist;
+  }
+  return best;
 }
 
 Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& options) {
@@ -1072,7 +1226,8 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
   }
   {
     std::vector<int> arms, torso, legs;
-    for (int j : {kRightShoulder, kRightElbow, kRightWrist, kLeftShoulder, kLeftElbow, kLeftWrist}) {
+    for (int j :
+         {kRightShoulder, kRightElbow, kRightWrist, kLeftShoulder, kLeftElbow, kLeftWrist}) {
       if (rig_of[j] < 0) arms.push_back(j);
     }
     for (int j : {kPelvis, kNeck, kHead}) {
@@ -1085,10 +1240,13 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
     missing.insert(missing.end(), torso.begin(), torso.end());
     missing.insert(missing.end(), legs.begin(), legs.end());
     if (!missing.empty()) {
-      const std::string what = !arms.empty() ? "no arm chain" : !torso.empty() ? "no torso chain" : "no leg chain";
+      const std::string what = !arms.empty()    ? "no arm chain"
+                               : !torso.empty() ? "no torso chain"
+                                                : "no leg chain";
       throw InputError(file, "skin",
-                       what + ": cannot map " + JoinCanonical(missing) + " (rig joints: " + JoinNames(rig.joint_name) +
-                           "; best table '" + mapping.convention + "'; pass a joint map)");
+                       what + ": cannot map " + JoinCanonical(missing) +
+                           " (rig joints: " + JoinNames(rig.joint_name) + "; best table '" +
+                           mapping.convention + "'; pass a joint map)");
     }
   }
 
@@ -1101,7 +1259,8 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
   std::vector<int> collapsed(rig_joints, kPelvis);
   for (int k = 0; k < rig_joints; ++k) {
     int a = k;
-    for (int guard = 0; a >= 0 && canonical_of[a] < 0 && guard <= rig_joints; ++guard) a = rig.joint_parent[a];
+    for (int guard = 0; a >= 0 && canonical_of[a] < 0 && guard <= rig_joints; ++guard)
+      a = rig.joint_parent[a];
     collapsed[k] = a >= 0 && canonical_of[a] >= 0 ? canonical_of[a] : kPelvis;
   }
 
@@ -1152,16 +1311,23 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
       d.cwiseAbs().maxCoeff(&axis);
       Vector3d up = Vector3d::Zero();
       up[axis] = d[axis] > 0 ? 1 : -1;
-      up_rotation = up.z() < -0.5 ? Eigen::AngleAxisd(M_PI, Vector3d::UnitX()).toRotationMatrix()
-                                  : Eigen::Quaterniond::FromTwoVectors(up, Vector3d::UnitZ()).toRotationMatrix();
+      up_rotation =
+          up.z() < -0.5
+              ? Eigen::AngleAxisd(M_PI, Vector3d::UnitX()).toRotationMatrix()
+              : Eigen::Quaterniond::FromTwoVectors(up, Vector3d::UnitZ()).toRotationMatrix();
       up_used = std::string(d[axis] > 0 ? "+" : "-") + "xyz"[axis] + " (auto)";
     } else {
       throw InputError(file, "up_axis", "must be auto, y or z, not '" + options.up_axis + "'");
     }
-    Vector3d right = up_rotation * ((rp(kRightShoulder) - rp(kLeftShoulder)) + (rp(kRightHip) - rp(kLeftHip)));
+    Vector3d right =
+        up_rotation * ((rp(kRightShoulder) - rp(kLeftShoulder)) + (rp(kRightHip) - rp(kLeftHip)));
     right.z() = 0;
-    if (right.norm() < 1e-9) throw InputError(file, "skin", "cannot tell the facing: the shoulders and hips are level along the up axis");
-    frame = Eigen::AngleAxisd(-std::atan2(right.y(), right.x()), Vector3d::UnitZ()).toRotationMatrix() * up_rotation;
+    if (right.norm() < 1e-9)
+      throw InputError(file, "skin",
+                       "cannot tell the facing: the left and right shoulders and hips coincide");
+    frame =
+        Eigen::AngleAxisd(-std::atan2(right.y(), right.x()), Vector3d::UnitZ()).toRotationMatrix() *
+        up_rotation;
 
     scale = options.scale > 0 ? options.scale : rig.unit_scale;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -1170,9 +1336,11 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
       lo = std::min(lo, z), hi = std::max(hi, z);
     }
     const double height = (hi - lo) * scale;
-    if (options.scale == 0 && !rig.unit_known && (height < 1.0 || height > 2.3) && height * 0.01 >= 1.0 &&
-        height * 0.01 <= 2.3) {
-      Log().info("avatar import: {}: {:.1f} units tall and no unit in the file: reading centimetres", file, hi - lo);
+    if (options.scale == 0 && !rig.unit_known && (height < 1.0 || height > 2.3) &&
+        height * 0.01 >= 1.0 && height * 0.01 <= 2.3) {
+      Log().info(
+          "avatar import: {}: {:.1f} units tall and no unit in the file: reading centimetres", file,
+          hi - lo);
       scale *= 0.01;
     }
     for (size_t v = 0; v < n; ++v) verts[v] = scale * (frame * rig.position[v]);
@@ -1191,16 +1359,20 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
       ++count;
     }
     if (attempt == 0 && count >= 8 && forward < -0.25 * spread) {
-      Log().warn("avatar import: {}: the feet point backwards: the rig's left/right joint names are the "
-                 "character's right/left; swapping them", file);
+      Log().warn(
+          "avatar import: {}: the feet point backwards: the rig's left/right joint names are the "
+          "character's right/left; swapping them",
+          file);
       std::array<int, kJointCount> swapped;
       for (int j = 0; j < kJointCount; ++j) swapped[j] = rig_of[Mirror(j)];
       rig_of = swapped;
       for (size_t v = 0; v < n; ++v) {
-        for (int k = 0; k < 4; ++k) bone_index[v][k] = static_cast<uint8_t>(Mirror(bone_index[v][k]));
+        for (int k = 0; k < 4; ++k)
+          bone_index[v][k] = static_cast<uint8_t>(Mirror(bone_index[v][k]));
       }
       std::map<std::string, std::string> map;
-      for (const auto& [canonical, rig_name] : mapping.map) map[JointName(Mirror(*JointFromName(canonical)))] = rig_name;
+      for (const auto& [canonical, rig_name] : mapping.map)
+        map[JointName(Mirror(*JointFromName(canonical)))] = rig_name;
       mapping.map = map;
       continue;
     }
@@ -1233,16 +1405,19 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
   std::array<Matrix3d, kJointCount> rot;
   const Vector3d ux = Vector3d::UnitX(), uz = Vector3d::UnitZ();
   auto aim = [&](int j, int child, const Vector3d& target, int parent) {
-    const Matrix3d& base = parent >= 0 ? rot[parent] : Matrix3d::Identity();
+    const Matrix3d base = parent >= 0 ? rot[parent] : Matrix3d(Matrix3d::Identity());
     const Vector3d bone = base * (p[child] - p[j]);
-    if (bone.norm() < 1e-9) throw InputError(file, "skin", std::string("the ") + JointName(j) + " and " + JointName(child) + " joints coincide");
+    if (bone.norm() < 1e-9)
+      throw InputError(
+          file, "skin",
+          std::string("the ") + JointName(j) + " and " + JointName(child) + " joints coincide");
     rot[j] = Eigen::Quaterniond::FromTwoVectors(bone, target).toRotationMatrix() * base;
   };
   aim(kPelvis, kChest, uz, -1);
   aim(kSpine, kChest, uz, kPelvis);
   aim(kChest, kNeck, uz, kSpine);
   aim(kNeck, kHead, uz, kChest);
-  rot[kHead] = rot[kChest];
+  rot[kHead] = Matrix3d::Identity();
   for (int side : {+1, -1}) {
     const int clav = side > 0 ? kRightClavicle : kLeftClavicle;
     rot[clav] = rot[kChest];
@@ -1271,20 +1446,25 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
   }
   // Feet on the floor, pelvis over the origin.
   double floor_z = std::numeric_limits<double>::infinity(), top_z = -floor_z;
-  for (const Vector3d& v : verts) floor_z = std::min(floor_z, v.z()), top_z = std::max(top_z, v.z());
+  for (const Vector3d& v : verts)
+    floor_z = std::min(floor_z, v.z()), top_z = std::max(top_z, v.z());
   const Vector3d shift(-q[kPelvis].x(), -q[kPelvis].y(), -floor_z);
   for (Vector3d& v : verts) v += shift;
   for (Vector3d& j : q) j += shift;
   const double h = top_z - floor_z;
   if (!(h >= 1.0 && h <= 2.3)) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "the imported body is %.3f m tall at %.4g m per file unit; expected 1.0..2.3 m "
-                                   "(give the scale in metres per file unit)", h, scale);
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "the imported body is %.3f m tall at %.4g m per file unit; expected 1.0..2.3 m "
+                  "(give \"scale\" in metres per file unit in an avatar file of kind \"mesh\", see "
+                  "docs/avatars.md)",
+                  h, scale);
     throw InputError(file, "height", buf);
   }
 
   Avatar avatar;
   avatar.params.name = options.name.empty() ? path.stem().string() : options.name;
+  avatar.params.kind = "mesh";
   avatar.params.height_m = h;
   avatar.params.build = 1.0;
   for (int j = 0; j < kJointCount; ++j) avatar.skeleton.bind_position[j] = q[j];
@@ -1309,7 +1489,8 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
     std::unordered_map<std::array<int64_t, 3>, int, KeyHash> group_of_key;
     std::vector<int> group(n);
     for (size_t v = 0; v < n; ++v) {
-      const std::array<int64_t, 3> key = {std::llround(verts[v].x() * 1e6), std::llround(verts[v].y() * 1e6),
+      const std::array<int64_t, 3> key = {std::llround(verts[v].x() * 1e6),
+                                          std::llround(verts[v].y() * 1e6),
                                           std::llround(verts[v].z() * 1e6)};
       group[v] = group_of_key.emplace(key, static_cast<int>(group_of_key.size())).first->second;
     }
@@ -1321,7 +1502,8 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
     }
     for (size_t v = 0; v < n; ++v) {
       const Vector3d& a = acc[group[v]];
-      avatar.bind_vertices[v].normal = a.norm() > 0 ? Eigen::Vector3f(a.normalized().cast<float>()) : Eigen::Vector3f::UnitZ();
+      avatar.bind_vertices[v].normal =
+          a.norm() > 0 ? Eigen::Vector3f(a.normalized().cast<float>()) : Eigen::Vector3f::UnitZ();
     }
   }
 
@@ -1331,83 +1513,111 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
   Vector3d head_offset(0, 0.005 * h, 0.050 * h);
   {
     Vector3d sum = Vector3d::Zero();
+    double top = -std::numeric_limits<double>::infinity();
     int count = 0;
     for (size_t v = 0; v < n; ++v) {
-      if (dominant[v] == kHead) sum += verts[v], ++count;
+      if (dominant[v] == kHead) sum += verts[v], ++count, top = std::max(top, verts[v].z());
     }
-    if (count > 0) head_offset = sum / count - q[kHead];
+    if (count > 0) {
+      head_offset = sum / count - q[kHead];
+      // Not above the middle between the head joint and the crown: where only
+      // the crown is head-weighted (the rigged figure's box head), the
+      // centroid would sit on top of the head.
+      head_offset.z() = std::min(head_offset.z(), 0.5 * (top - q[kHead].z()));
+    }
   }
   std::array<double, 2> hand_length{0.108 * h, 0.108 * h};  // right, left
+  std::array<Vector3d, 2> hand_tip;
   for (int side : {+1, -1}) {
     const int wrist = side > 0 ? kRightWrist : kLeftWrist;
     double best = -1;
     for (size_t v = 0; v < n; ++v) {
       const double along = side * (verts[v].x() - q[wrist].x());
-      if (dominant[v] == wrist || (dominant[v] == wrist - 1 && along > 0)) best = std::max(best, along);
+      if (dominant[v] == wrist || (dominant[v] == wrist - 1 && along > 0))
+        best = std::max(best, along);
     }
     if (best > 0) hand_length[side > 0 ? 0 : 1] = best;
+    // Centred on the fingers' ends: the mean height and depth of the hand
+    // vertices in the last 1.5% of the height (fingers that hang or bend off
+    // the forearm axis keep the tip on the hand).
+    Vector3d sum = Vector3d::Zero();
+    int count = 0;
+    for (size_t v = 0; v < n && best > 0; ++v) {
+      const double along = side * (verts[v].x() - q[wrist].x());
+      if ((dominant[v] == wrist || (dominant[v] == wrist - 1 && along > 0)) && along >= best - 0.015 * h)
+        sum += verts[v] - q[wrist], ++count;
+    }
+    const int s = side > 0 ? 0 : 1;
+    hand_tip[s] = Vector3d(side * hand_length[s], 0, 0);
+    if (count > 0) hand_tip[s].y() = sum.y() / count, hand_tip[s].z() = sum.z() / count;
   }
   avatar.markers = {{"head", kHead, head_offset},
-                    {"right_hand_tip", kRightWrist, {hand_length[0], 0, 0}},
-                    {"left_hand_tip", kLeftWrist, {-hand_length[1], 0, 0}}};
+                    {"right_hand_tip", kRightWrist, hand_tip[0]},
+                    {"left_hand_tip", kLeftWrist, hand_tip[1]}};
 
-  // Body radii.
-  auto radius = [&](const Vector3d& centre, const Vector3d& axis, double slab_centre, double slab_half,
-                    std::initializer_list<int> joints, double fallback) {
-    std::vector<double> d;
-    for (size_t v = 0; v < n; ++v) {
-      if (std::find(joints.begin(), joints.end(), dominant[v]) == joints.end()) continue;
-      const Vector3d r = verts[v] - centre;
-      if (axis.isZero()) {
-        d.push_back(r.norm());
-        continue;
+  // Body radii: the median distance to the surface along rays from the point,
+  // across the body segment (or in all directions for the head).
+  auto radius = [&](const Vector3d& centre, const Vector3d& axis, double fallback) {
+    std::vector<Vector3d> directions;
+    if (axis.isZero()) {
+      const int count = 64;  // Fibonacci sphere
+      for (int i = 0; i < count; ++i) {
+        const double z = 1 - (2 * i + 1.0) / count, r = std::sqrt(1 - z * z),
+                     phi = i * M_PI * (3 - std::sqrt(5.0));
+        directions.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
       }
-      const double along = r.dot(axis);
-      if (std::abs(along - slab_centre) > slab_half) continue;
-      d.push_back((r - along * axis).norm());
+    } else {
+      const Vector3d a = axis.unitOrthogonal(), b = axis.cross(a).normalized();
+      for (int i = 0; i < 16; ++i) {
+        const double phi = 2 * M_PI * i / 16;
+        directions.push_back(std::cos(phi) * a + std::sin(phi) * b);
+      }
     }
-    return d.size() >= 6 ? Median(d) : fallback;
+    std::vector<double> hits;
+    for (const Vector3d& d : directions) {
+      const double t = RayHit(verts, avatar.indices, centre, d);
+      if (std::isfinite(t)) hits.push_back(t);
+    }
+    // Most rays miss when the point lies outside the mesh.
+    return 2 * hits.size() >= directions.size() ? Median(hits) : fallback;
   };
   auto both = [&](auto&& f) { return 0.5 * (f(+1) + f(-1)); };
-  const Vector3d head_centre = q[kHead] + head_offset;
   avatar.truth_radius["root"] = 0.0;
-  avatar.truth_radius["waist"] = radius(q[kSpine], uz, 0, 0.03 * h, {kPelvis, kSpine, kChest}, 0.075 * h);
-  avatar.truth_radius["neck"] = radius(q[kNeck], uz, 0, 0.03 * h, {kNeck, kHead}, 0.040 * h);
-  avatar.truth_radius["head"] = radius(head_centre, Vector3d::Zero(), 0, 0, {kHead}, 0.058 * h);
-  avatar.truth_radius["shoulder"] = both([&](int s) {
-    const int j = s > 0 ? kRightShoulder : kLeftShoulder;
-    return radius(q[j], s * ux, 0, 0.03 * h, {j, j - 1}, 0.040 * h);
-  });
-  avatar.truth_radius["elbow"] = both([&](int s) {
-    const int j = s > 0 ? kRightElbow : kLeftElbow;
-    return radius(q[j], s * ux, 0, 0.02 * h, {j, j - 1}, 0.025 * h);
-  });
-  avatar.truth_radius["wrist"] = both([&](int s) {
-    const int j = s > 0 ? kRightWrist : kLeftWrist;
-    return radius(q[j], s * ux, 0, 0.02 * h, {j, j - 1}, 0.018 * h);
-  });
+  avatar.truth_radius["waist"] = radius(q[kSpine], uz, 0.075 * h);
+  avatar.truth_radius["neck"] = radius(q[kNeck], uz, 0.040 * h);
+  avatar.truth_radius["head"] = radius(q[kHead] + head_offset, Vector3d::Zero(), 0.058 * h);
+  const std::map<std::string, std::pair<int, double>> limbs = {
+      {"shoulder", {kRightShoulder, 0.040}}, {"elbow", {kRightElbow, 0.025}},
+      {"wrist", {kRightWrist, 0.018}},       {"hip", {kRightHip, 0.060}},
+      {"knee", {kRightKnee, 0.034}},         {"ankle", {kRightAnkle, 0.025}}};
+  for (const auto& [key, joint_fraction] : limbs) {
+    const auto [right, fraction] = joint_fraction;
+    const bool arm = right <= kRightWrist;
+    avatar.truth_radius[key] = both([&](int s) {
+      const int j = s > 0 ? right : Mirror(right);
+      return radius(q[j], arm ? Vector3d(s * ux) : uz, fraction * h);
+    });
+  }
+  // The hand tip lies on the surface: the hand's half thickness 1.5% of the
+  // height behind it.
   avatar.truth_radius["hand_tip"] = both([&](int s) {
     const int j = s > 0 ? kRightWrist : kLeftWrist;
-    const Vector3d tip = q[j] + Vector3d(s * hand_length[s > 0 ? 0 : 1], 0, 0);
-    return radius(tip, s * ux, -0.015 * h, 0.015 * h, {j}, 0.010 * h);
-  });
-  avatar.truth_radius["hip"] = both([&](int s) {
-    const int j = s > 0 ? kRightHip : kLeftHip;
-    return radius(q[j], uz, 0, 0.03 * h, {j}, 0.060 * h);
-  });
-  avatar.truth_radius["knee"] = both([&](int s) {
-    const int j = s > 0 ? kRightKnee : kLeftKnee;
-    return radius(q[j], uz, 0, 0.02 * h, {j, j - 1}, 0.034 * h);
-  });
-  avatar.truth_radius["ankle"] = both([&](int s) {
-    const int j = s > 0 ? kRightAnkle : kLeftAnkle;
-    return radius(q[j], uz, 0, 0.02 * h, {j, j - 1}, 0.025 * h);
+    const Vector3d& tip = hand_tip[s > 0 ? 0 : 1];
+    return radius(q[j] + tip - Vector3d(s * std::min(std::abs(tip.x()), 0.015 * h), 0, 0), s * ux, 0.010 * h);
   });
 
-  Log().info("avatar import: {}: {} rig, up {}, {:.4g} m/unit, {} vertices, {} triangles, {:.3f} m tall{}{}", file,
-             mapping.convention, up_used, scale, n, avatar.indices.size() / 3, h,
-             mapping.unmapped_rig_joints.empty() ? "" : "; unmapped rig joints (follow their parents): ",
-             JoinNames(mapping.unmapped_rig_joints, 12));
+  avatar.params.source = {{"file", path.string()},
+                          {"convention", mapping.convention},
+                          {"up_axis", up_used},
+                          {"scale", scale},
+                          {"joint_map", mapping.map},
+                          {"unmapped_rig_joints", mapping.unmapped_rig_joints}};
+  Log().info(
+      "avatar import: {}: {} rig, up {}, {:.4g} m/unit, {} vertices, {} triangles, {:.3f} m "
+      "tall{}{}",
+      file, mapping.convention, up_used, scale, n, avatar.indices.size() / 3, h,
+      mapping.unmapped_rig_joints.empty() ? "" : "; unmapped rig joints (follow their parents): ",
+      JoinNames(mapping.unmapped_rig_joints, 12));
   return avatar;
 }
 

@@ -27,14 +27,18 @@ struct ImportOptions {
   // Metres per file unit; 0: glTF is metres, assimp formats use the file's unit
   // metadata, else centimetres are tried when the height is implausible.
   double scale = 0;
-  std::string up_axis = "auto";  // "auto" (from the skeleton), "y", "z"
+  // The file's up axis in its world frame (glTF: after the node transforms):
+  // "auto" (the axis nearest to pelvis -> head), "y" or "z".
+  std::string up_axis = "auto";
 };
 
 // Canonical joint name -> rig joint name (the rig's own spelling), from the
 // built-in tables for a rig's joint names; `convention` names the table used
-// ("mixamo", "rigify", "makehuman", "unreal", "cesium", "generic", "daz",
-// "3dsmax", "cmu", or "unknown"). `unmapped_rig_joints` are the rig joints no
-// canonical joint maps to (on import they follow their nearest mapped ancestor).
+// ("irbench", "mixamo", "rigify", "makehuman", "unreal", "cesium", "generic", "daz",
+// "3dsmax", "cmu"; "+overrides" appended when the caller's map changed it,
+// "custom" when only the caller's map applies, "unknown" when nothing maps).
+// `unmapped_rig_joints` are the rig joints no canonical joint maps to (on
+// import they follow their nearest mapped ancestor).
 struct JointMapping {
   std::string convention;
   std::map<std::string, std::string> map;

@@ -1,19 +1,20 @@
 #include "sim/body/avatar_import.h"
 
-#include <assimp/Exporter.hpp>
-#include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
-#include <unistd.h>
 
 #include "common/error.h"
+#include "sim/body/gltf_export.h"
 
 namespace irbench {
 namespace {
@@ -23,7 +24,9 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------
 // Joint-name tables.
 
-std::vector<std::string> Sided(const std::vector<std::string>& names, const std::string& left, const std::string& right,
+std::vector<std::string> Sided(const std::vector<std::string>& names,
+                               const std::string& left,
+                               const std::string& right,
                                bool prefix) {
   std::vector<std::string> out;
   for (const std::string& n : names) {
@@ -43,10 +46,11 @@ void ExpectMapped(const JointMapping& m, const std::map<std::string, std::string
 }
 
 TEST(MapRigJointsTest, Mixamo) {
-  std::vector<std::string> names = {"mixamorig:Hips", "mixamorig:Spine", "mixamorig:Spine1", "mixamorig:Spine2",
-                                    "mixamorig:Neck", "mixamorig:Head",  "mixamorig:HeadTop_End"};
-  for (const std::string& n : Sided({"Shoulder", "Arm", "ForeArm", "Hand", "HandIndex1", "HandThumb1", "UpLeg", "Leg",
-                                     "Foot", "ToeBase"},
+  std::vector<std::string> names = {"mixamorig:Hips",       "mixamorig:Spine", "mixamorig:Spine1",
+                                    "mixamorig:Spine2",     "mixamorig:Neck",  "mixamorig:Head",
+                                    "mixamorig:HeadTop_End"};
+  for (const std::string& n : Sided({"Shoulder", "Arm", "ForeArm", "Hand", "HandIndex1",
+                                     "HandThumb1", "UpLeg", "Leg", "Foot", "ToeBase"},
                                     "mixamorig:Left", "mixamorig:Right", true)) {
     names.push_back(n);
   }
@@ -77,11 +81,12 @@ TEST(MapRigJointsTest, Mixamo) {
 }
 
 TEST(MapRigJointsTest, Rigify) {
-  std::vector<std::string> names = {"DEF-spine",     "DEF-spine.001", "DEF-spine.002", "DEF-spine.003",
-                                    "DEF-spine.004", "DEF-spine.005", "DEF-spine.006"};
+  std::vector<std::string> names = {"DEF-spine",     "DEF-spine.001", "DEF-spine.002",
+                                    "DEF-spine.003", "DEF-spine.004", "DEF-spine.005",
+                                    "DEF-spine.006"};
   for (const char* side : {".L", ".R"}) {
-    for (const char* bone : {"DEF-shoulder", "DEF-upper_arm", "DEF-forearm", "DEF-hand", "DEF-thigh", "DEF-shin",
-                             "DEF-foot", "DEF-toe"}) {
+    for (const char* bone : {"DEF-shoulder", "DEF-upper_arm", "DEF-forearm", "DEF-hand",
+                             "DEF-thigh", "DEF-shin", "DEF-foot", "DEF-toe"}) {
       names.push_back(std::string(bone) + side);
     }
     // Rigify's twist segments.
@@ -111,7 +116,9 @@ TEST(MapRigJointsTest, Rigify) {
 
 TEST(MapRigJointsTest, BlenderMetarigIsGeneric) {
   std::vector<std::string> names = {"hips", "spine", "chest", "neck", "head"};
-  for (const std::string& n : Sided({"shoulder", "upper_arm", "forearm", "hand", "thigh", "shin", "foot"}, ".L", ".R", false)) {
+  for (const std::string& n :
+       Sided({"shoulder", "upper_arm", "forearm", "hand", "thigh", "shin", "foot"}, ".L", ".R",
+             false)) {
     names.push_back(n);
   }
   const JointMapping m = MapRigJoints(names, {});
@@ -134,9 +141,10 @@ TEST(MapRigJointsTest, BlenderMetarigIsGeneric) {
 TEST(MapRigJointsTest, MakeHumanDefaultAndGameEngine) {
   std::vector<std::string> names = {"root",   "spine05", "spine04", "spine03", "spine02", "spine01",
                                     "neck01", "neck02",  "neck03",  "head",    "jaw"};
-  for (const std::string& n : Sided({"clavicle", "shoulder01", "upperarm01", "upperarm02", "lowerarm01", "lowerarm02",
-                                     "wrist", "pelvis", "upperleg01", "upperleg02", "lowerleg01", "lowerleg02", "foot"},
-                                    ".L", ".R", false)) {
+  for (const std::string& n :
+       Sided({"clavicle", "shoulder01", "upperarm01", "upperarm02", "lowerarm01", "lowerarm02",
+              "wrist", "pelvis", "upperleg01", "upperleg02", "lowerleg01", "lowerleg02", "foot"},
+             ".L", ".R", false)) {
     names.push_back(n);
   }
   const JointMapping m = MapRigJoints(names, {});
@@ -158,8 +166,9 @@ TEST(MapRigJointsTest, MakeHumanDefaultAndGameEngine) {
                    {"right_ankle", "foot.R"}});
 
   std::vector<std::string> game = {"pelvis", "spine_01", "spine_02", "spine_03", "neck_01", "head"};
-  for (const std::string& n : Sided({"clavicle", "upperarm", "lowerarm", "hand", "thigh", "calf", "foot", "ball"}, "_l",
-                                    "_r", false)) {
+  for (const std::string& n :
+       Sided({"clavicle", "upperarm", "lowerarm", "hand", "thigh", "calf", "foot", "ball"}, "_l",
+             "_r", false)) {
     game.push_back(n);
   }
   const JointMapping g = MapRigJoints(game, {});
@@ -179,13 +188,16 @@ TEST(MapRigJointsTest, MakeHumanDefaultAndGameEngine) {
 }
 
 const std::vector<std::string> kWizardJoints = {
-    "Root",     "Foot.L",     "Body",       "Hips",       "Abdomen",  "Torso",    "Neck",       "Head",
-    "Shoulder.L", "UpperArm.L", "LowerArm.L", "Fist.L",   "Fist1.L",  "Fist2.L",  "Thumb1.L",   "Thumb2.L",
-    "Shoulder.R", "UpperArm.R", "LowerArm.R", "Fist.R",   "Fist1.R",  "Fist2.R",  "Weapon.R",   "Thumb1.R",
-    "Thumb2.R", "UpperLeg.L", "LowerLeg.L", "UpperLeg.R", "LowerLeg.R", "PoleTarget.L", "Foot.R", "PoleTarget.R"};
+    "Root",       "Foot.L",      "Body",       "Hips",       "Abdomen",    "Torso",
+    "Neck",       "Head",        "Shoulder.L", "UpperArm.L", "LowerArm.L", "Fist.L",
+    "Fist1.L",    "Fist2.L",     "Thumb1.L",   "Thumb2.L",   "Shoulder.R", "UpperArm.R",
+    "LowerArm.R", "Fist.R",      "Fist1.R",    "Fist2.R",    "Weapon.R",   "Thumb1.R",
+    "Thumb2.R",   "UpperLeg.L",  "LowerLeg.L", "UpperLeg.R", "LowerLeg.R", "PoleTarget.L",
+    "Foot.R",     "PoleTarget.R"};
 
 TEST(MapRigJointsTest, Wizard) {
   const JointMapping m = MapRigJoints(kWizardJoints, {});
+  EXPECT_EQ(m.convention, "generic");
   ExpectMapped(m, {{"pelvis", "Hips"},
                    {"spine", "Abdomen"},
                    {"chest", "Torso"},
@@ -210,12 +222,25 @@ TEST(MapRigJointsTest, Wizard) {
 TEST(MapRigJointsTest, CesiumManAndRiggedFigure) {
   // CesiumMan numbers its two arms differently (verified on the joint
   // positions: L__4_ -> L__3_ -> L__2_ and R -> R__2_ -> R__3_ run outwards).
-  const std::vector<std::string> cesium_man = {
-      "Skeleton_torso_joint_1", "Skeleton_torso_joint_2", "torso_joint_3", "Skeleton_neck_joint_1",
-      "Skeleton_neck_joint_2", "Skeleton_arm_joint_L__4_", "Skeleton_arm_joint_R", "Skeleton_arm_joint_L__3_",
-      "Skeleton_arm_joint_R__2_", "Skeleton_arm_joint_L__2_", "Skeleton_arm_joint_R__3_", "leg_joint_L_1",
-      "leg_joint_R_1", "leg_joint_L_2", "leg_joint_R_2", "leg_joint_L_3", "leg_joint_R_3", "leg_joint_L_5",
-      "leg_joint_R_5"};
+  const std::vector<std::string> cesium_man = {"Skeleton_torso_joint_1",
+                                               "Skeleton_torso_joint_2",
+                                               "torso_joint_3",
+                                               "Skeleton_neck_joint_1",
+                                               "Skeleton_neck_joint_2",
+                                               "Skeleton_arm_joint_L__4_",
+                                               "Skeleton_arm_joint_R",
+                                               "Skeleton_arm_joint_L__3_",
+                                               "Skeleton_arm_joint_R__2_",
+                                               "Skeleton_arm_joint_L__2_",
+                                               "Skeleton_arm_joint_R__3_",
+                                               "leg_joint_L_1",
+                                               "leg_joint_R_1",
+                                               "leg_joint_L_2",
+                                               "leg_joint_R_2",
+                                               "leg_joint_L_3",
+                                               "leg_joint_R_3",
+                                               "leg_joint_L_5",
+                                               "leg_joint_R_5"};
   const JointMapping m = MapRigJoints(cesium_man, {});
   EXPECT_EQ(m.convention, "cesium");
   ExpectMapped(m, {{"pelvis", "Skeleton_torso_joint_1"},
@@ -236,10 +261,10 @@ TEST(MapRigJointsTest, CesiumManAndRiggedFigure) {
   EXPECT_EQ(m.map.count("left_clavicle"), 0u);
 
   const std::vector<std::string> figure = {
-      "torso_joint_1", "torso_joint_2", "torso_joint_3", "neck_joint_1",  "neck_joint_2",  "arm_joint_L_1",
-      "arm_joint_R_1", "arm_joint_L_2", "arm_joint_R_2", "arm_joint_L_3", "arm_joint_R_3", "leg_joint_L_1",
-      "leg_joint_R_1", "leg_joint_L_2", "leg_joint_R_2", "leg_joint_L_3", "leg_joint_R_3", "leg_joint_L_5",
-      "leg_joint_R_5"};
+      "torso_joint_1", "torso_joint_2", "torso_joint_3", "neck_joint_1",  "neck_joint_2",
+      "arm_joint_L_1", "arm_joint_R_1", "arm_joint_L_2", "arm_joint_R_2", "arm_joint_L_3",
+      "arm_joint_R_3", "leg_joint_L_1", "leg_joint_R_1", "leg_joint_L_2", "leg_joint_R_2",
+      "leg_joint_L_3", "leg_joint_R_3", "leg_joint_L_5", "leg_joint_R_5"};
   const JointMapping f = MapRigJoints(figure, {});
   EXPECT_EQ(f.convention, "cesium");
   ExpectMapped(f, {{"pelvis", "torso_joint_1"},
@@ -256,7 +281,8 @@ TEST(MapRigJointsTest, CesiumManAndRiggedFigure) {
 }
 
 TEST(MapRigJointsTest, OverridesWinAndAreChecked) {
-  const JointMapping m = MapRigJoints(kWizardJoints, {{"right_wrist", "fist1.r"}, {"left_clavicle", ""}});
+  const JointMapping m =
+      MapRigJoints(kWizardJoints, {{"right_wrist", "fist1.r"}, {"left_clavicle", ""}});
   EXPECT_EQ(m.map.at("right_wrist"), "Fist1.R");
   EXPECT_EQ(m.map.count("left_clavicle"), 0u);
   // The override takes the rig joint from the table's choice.
@@ -281,10 +307,13 @@ TEST(MapRigJointsTest, OverridesWinAndAreChecked) {
 // ---------------------------------------------------------------------------
 // Importing the test avatars.
 
-fs::path AvatarDir() { return fs::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "avatars"; }
+fs::path AvatarDir() {
+  return fs::path(IRBENCH_SOURCE_DIR) / ".." / "shared" / "data" / "avatars";
+}
 
 fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / ("irbench_import_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("irbench_import_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir;
 }
@@ -318,7 +347,8 @@ struct Case {
 // a separate Python script reading the GLB's JSON and BIN chunks (raw skinned
 // positions; rigid meshes placed by their joint's inverse bind matrix), at the
 // 0.6 m per unit the test imports it with.
-const Case kCases[] = {{"CesiumMan.glb", 0, 1.507}, {"rigged_figure.glb", 0, 1.450}, {"Wizard.glb", 0.6, 0.6 * 3.078}};
+const Case kCases[] = {
+    {"CesiumMan.glb", 0, 1.507}, {"rigged_figure.glb", 0, 1.450}, {"Wizard.glb", 0.6, 0.6 * 3.078}};
 
 class ImportTest : public ::testing::TestWithParam<Case> {};
 
@@ -375,7 +405,8 @@ TEST_P(ImportTest, StandsInTheCanonicalTPose) {
   }
 
   // T-pose.
-  for (const auto& [shoulder, sign] : {std::pair{kRightShoulder, 1.0}, std::pair{kLeftShoulder, -1.0}}) {
+  for (const auto& [shoulder, sign] :
+       {std::pair{kRightShoulder, 1.0}, std::pair{kLeftShoulder, -1.0}}) {
     const Eigen::Vector3d x(sign, 0, 0);
     const double upper = AngleDeg(b[shoulder + 1] - b[shoulder], x);
     const double fore = AngleDeg(b[shoulder + 2] - b[shoulder + 1], x);
@@ -415,11 +446,12 @@ TEST_P(ImportTest, StandsInTheCanonicalTPose) {
   const auto truth = TruthJoints(avatar, bind);
   const auto& names = TruthJointNames();
   for (size_t i = 0; i < truth.size(); ++i) EXPECT_TRUE(truth[i].allFinite()) << names[i];
-  EXPECT_GT(truth[3].z(), truth[2].z());              // head above the neck
+  EXPECT_GT(truth[3].z(), truth[2].z());                // head above the neck
   EXPECT_GT(truth[11].x(), b[kRightWrist].x() + 0.02);  // right hand tip beyond the wrist
-  EXPECT_NEAR(truth[11].x(), right_end.x(), 0.01);    // ... at the end of the hand
+  EXPECT_NEAR(truth[11].x(), right_end.x(), 0.01);      // ... at the end of the hand
   EXPECT_LT(truth[7].x(), b[kLeftWrist].x() - 0.02);
-  for (const char* key : {"root", "waist", "neck", "head", "shoulder", "elbow", "wrist", "hand_tip", "hip", "knee", "ankle"}) {
+  for (const char* key : {"root", "waist", "neck", "head", "shoulder", "elbow", "wrist", "hand_tip",
+                          "hip", "knee", "ankle"}) {
     ASSERT_TRUE(avatar.truth_radius.count(key)) << key;
     EXPECT_GE(avatar.truth_radius.at(key), 0.0) << key;
     EXPECT_LT(avatar.truth_radius.at(key), 0.3) << key;
@@ -431,7 +463,8 @@ TEST_P(ImportTest, StandsInTheCanonicalTPose) {
   ASSERT_EQ(skinned.size(), avatar.bind_vertices.size());
   double worst = 0;
   for (size_t i = 0; i < skinned.size(); ++i) {
-    worst = std::max<double>(worst, (skinned[i].position - avatar.bind_vertices[i].position).norm());
+    worst =
+        std::max<double>(worst, (skinned[i].position - avatar.bind_vertices[i].position).norm());
   }
   EXPECT_LT(worst, 1e-5);
 
@@ -442,21 +475,29 @@ TEST_P(ImportTest, StandsInTheCanonicalTPose) {
   EXPECT_GT((skinned[max_x].position - avatar.bind_vertices[max_x].position).norm(), 0.1);
   EXPECT_LT((skinned[min_x].position - avatar.bind_vertices[min_x].position).norm(), 1e-5);
 
-  std::printf("%s: height %.3f m, %zu vertices, %zu triangles; shoulders %.3f apart at z %.3f, wrists x %.3f/%.3f, "
-              "hand tips x %.3f/%.3f, head %.3f; radii waist %.3f neck %.3f head %.3f shoulder %.3f elbow %.3f "
-              "wrist %.3f hand_tip %.3f hip %.3f knee %.3f ankle %.3f\n",
-              c.file, h, avatar.bind_vertices.size(), avatar.indices.size() / 3,
-              (b[kRightShoulder] - b[kLeftShoulder]).norm(), b[kRightShoulder].z(), b[kRightWrist].x(),
-              b[kLeftWrist].x(), truth[11].x(), truth[7].x(), truth[3].z(), avatar.truth_radius.at("waist"),
-              avatar.truth_radius.at("neck"), avatar.truth_radius.at("head"), avatar.truth_radius.at("shoulder"),
-              avatar.truth_radius.at("elbow"), avatar.truth_radius.at("wrist"), avatar.truth_radius.at("hand_tip"),
-              avatar.truth_radius.at("hip"), avatar.truth_radius.at("knee"), avatar.truth_radius.at("ankle"));
+  std::printf(
+      "%s: height %.3f m, %zu vertices, %zu triangles; shoulders %.3f apart at z %.3f, wrists x "
+      "%.3f/%.3f, "
+      "hand tips x %.3f/%.3f, head %.3f; radii waist %.3f neck %.3f head %.3f shoulder %.3f elbow "
+      "%.3f "
+      "wrist %.3f hand_tip %.3f hip %.3f knee %.3f ankle %.3f\n",
+      c.file, h, avatar.bind_vertices.size(), avatar.indices.size() / 3,
+      (b[kRightShoulder] - b[kLeftShoulder]).norm(), b[kRightShoulder].z(), b[kRightWrist].x(),
+      b[kLeftWrist].x(), truth[11].x(), truth[7].x(), truth[3].z(), avatar.truth_radius.at("waist"),
+      avatar.truth_radius.at("neck"), avatar.truth_radius.at("head"),
+      avatar.truth_radius.at("shoulder"), avatar.truth_radius.at("elbow"),
+      avatar.truth_radius.at("wrist"), avatar.truth_radius.at("hand_tip"),
+      avatar.truth_radius.at("hip"), avatar.truth_radius.at("knee"),
+      avatar.truth_radius.at("ankle"));
 }
 
-INSTANTIATE_TEST_SUITE_P(Avatars, ImportTest, ::testing::ValuesIn(kCases),
+INSTANTIATE_TEST_SUITE_P(Avatars,
+                         ImportTest,
+                         ::testing::ValuesIn(kCases),
                          [](const ::testing::TestParamInfo<Case>& info) {
                            std::string s = fs::path(info.param.file).stem().string();
-                           for (char& ch : s) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+                           for (char& ch : s)
+                             ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
                            return s;
                          });
 
@@ -513,7 +554,7 @@ void RenameNodes(Glb& glb, const std::map<std::string, std::string>& renames) {
   }
 }
 
-class ImportErrorTest : public ::testing::Test {
+class ImportFigureTest : public ::testing::Test {
  protected:
   void SetUp() override {
     figure_ = AvatarDir() / "rigged_figure.glb";
@@ -528,11 +569,12 @@ class ImportErrorTest : public ::testing::Test {
 
 TEST(ImportErrors, MissingFile) {
   std::string message;
-  EXPECT_EQ(ErrorField([] { ImportRiggedAvatar("/nonexistent/irbench/avatar.glb"); }, &message), "file");
+  EXPECT_EQ(ErrorField([] { ImportRiggedAvatar("/nonexistent/irbench/avatar.glb"); }, &message),
+            "file");
   EXPECT_NE(message.find("/nonexistent/irbench/avatar.glb"), std::string::npos) << message;
 }
 
-TEST_F(ImportErrorTest, CorruptGlb) {
+TEST_F(ImportFigureTest, CorruptGlb) {
   std::ifstream in(figure_, std::ios::binary);
   std::string head(200, '\0');
   in.read(head.data(), 200);
@@ -556,7 +598,7 @@ TEST_F(ImportErrorTest, CorruptGlb) {
   EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(dir_ / "garbage.glb"); }, &message), "file");
 }
 
-TEST_F(ImportErrorTest, RenamedArmJointsAreNoArmChain) {
+TEST_F(ImportFigureTest, RenamedArmJointsAreNoArmChain) {
   Glb glb = ReadGlb(figure_);
   RenameNodes(glb, {{"arm_joint_R_1", "bone_a"}, {"arm_joint_R_2", "bone_b"}});
   const fs::path file = dir_ / "no_arm.glb";
@@ -574,7 +616,7 @@ TEST_F(ImportErrorTest, RenamedArmJointsAreNoArmChain) {
   EXPECT_NO_THROW(ImportRiggedAvatar(file, options));
 }
 
-TEST_F(ImportErrorTest, NoSkinAndNoMesh) {
+TEST_F(ImportFigureTest, NoSkinAndNoMesh) {
   Glb glb = ReadGlb(figure_);
   glb.json.erase("skins");
   for (auto& node : glb.json["nodes"]) node.erase("skin");
@@ -583,6 +625,13 @@ TEST_F(ImportErrorTest, NoSkinAndNoMesh) {
   WriteGlb(file, glb);
   EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(file); }), "skin");
 
+  // A skin no mesh uses.
+  Glb meshless = ReadGlb(figure_);
+  for (auto& node : meshless.json["nodes"]) node.erase("mesh");
+  const fs::path no_mesh = dir_ / "no_mesh.glb";
+  WriteGlb(no_mesh, meshless);
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(no_mesh); }), "skin");
+
   const fs::path obj = dir_ / "triangle.obj";
   std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
   std::string message;
@@ -590,7 +639,7 @@ TEST_F(ImportErrorTest, NoSkinAndNoMesh) {
   std::printf("obj: %s\n", message.c_str());
 }
 
-TEST_F(ImportErrorTest, BadOptionsAndHeight) {
+TEST_F(ImportFigureTest, BadOptionsAndHeight) {
   ImportOptions options;
   options.up_axis = "w";
   EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(figure_, options); }), "up_axis");
@@ -606,14 +655,15 @@ TEST_F(ImportErrorTest, BadOptionsAndHeight) {
   const fs::path wizard = AvatarDir() / "Wizard.glb";
   if (fs::exists(wizard)) {
     std::string message;
-    EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(wizard); }, &message), "height");  // 3 units, glTF metres
+    EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(wizard); }, &message),
+              "height");  // 3 units, glTF metres
     std::printf("%s\n", message.c_str());
   }
 }
 
 // The same figure with its left/right joint names swapped: the feet give the
 // sides away and the import comes out the same.
-TEST_F(ImportErrorTest, SwappedSideNamesAreDetected) {
+TEST_F(ImportFigureTest, SwappedSideNamesAreDetected) {
   Glb glb = ReadGlb(figure_);
   std::map<std::string, std::string> swap;
   for (const char* chain : {"arm_joint_", "leg_joint_"}) {
@@ -628,22 +678,27 @@ TEST_F(ImportErrorTest, SwappedSideNamesAreDetected) {
   const Avatar reference = ImportRiggedAvatar(figure_);
   const Avatar swapped = ImportRiggedAvatar(file);
   for (int j = 0; j < kJointCount; ++j) {
-    EXPECT_LT((swapped.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 1e-6) << JointName(j);
+    EXPECT_LT((swapped.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(),
+              1e-6)
+        << JointName(j);
   }
   ASSERT_EQ(swapped.bind_vertices.size(), reference.bind_vertices.size());
   for (size_t i = 0; i < swapped.bind_vertices.size(); ++i) {
-    ASSERT_LT((swapped.bind_vertices[i].position - reference.bind_vertices[i].position).norm(), 1e-5f) << i;
+    ASSERT_LT((swapped.bind_vertices[i].position - reference.bind_vertices[i].position).norm(),
+              1e-5f)
+        << i;
   }
 }
 
 // Up axis given or found, same result; Collada through assimp, same body.
-TEST_F(ImportErrorTest, UpAxisOptionAndAssimpPath) {
+TEST_F(ImportFigureTest, UpAxisOptionAndAssimpPath) {
   const Avatar reference = ImportRiggedAvatar(figure_);
   ImportOptions options;
   options.up_axis = "y";  // the figure's node tree turns its z-up mesh y-up
   const Avatar y_up = ImportRiggedAvatar(figure_, options);
   for (int j = 0; j < kJointCount; ++j) {
-    EXPECT_LT((y_up.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 1e-6) << JointName(j);
+    EXPECT_LT((y_up.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 1e-6)
+        << JointName(j);
   }
 
   // glTF -> Collada with assimp's own exporter, then imported through assimp.
@@ -652,18 +707,156 @@ TEST_F(ImportErrorTest, UpAxisOptionAndAssimpPath) {
   ASSERT_NE(scene, nullptr) << importer.GetErrorString();
   const fs::path dae = dir_ / "figure.dae";
   Assimp::Exporter exporter;
-  ASSERT_EQ(exporter.Export(scene, "collada", dae.string()), AI_SUCCESS) << exporter.GetErrorString();
+  ASSERT_EQ(exporter.Export(scene, "collada", dae.string()), AI_SUCCESS)
+      << exporter.GetErrorString();
   Avatar from_dae;
   ASSERT_NO_THROW(from_dae = ImportRiggedAvatar(dae));
   EXPECT_NEAR(from_dae.params.height_m, 1.450, 0.03);
   for (int j = 0; j < kJointCount; ++j) {
-    EXPECT_LT((from_dae.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 0.01) << JointName(j);
+    EXPECT_LT((from_dae.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(),
+              0.01)
+        << JointName(j);
   }
   for (const auto& w : from_dae.bone_weight) EXPECT_NEAR(w[0] + w[1] + w[2] + w[3], 1.0f, 1e-5f);
   std::vector<MeshVertex> skinned;
   SkinVertices(from_dae, ForwardKinematics(from_dae.skeleton, Pose()), skinned);
   for (size_t i = 0; i < skinned.size(); ++i) {
     ASSERT_LT((skinned[i].position - from_dae.bind_vertices[i].position).norm(), 1e-5f);
+  }
+}
+
+// A file in centimetres with no unit (assimp's own binary format, the figure
+// scaled by 100 at its root): read as centimetres; the scale option wins.
+TEST_F(ImportFigureTest, CentimetresWithoutUnitMetadata) {
+  Assimp::Importer importer;
+  ASSERT_NE(importer.ReadFile(figure_.string(), 0), nullptr) << importer.GetErrorString();
+  aiScene* scene = importer.GetOrphanedScene();
+  scene->mRootNode->mTransformation =
+      aiMatrix4x4(aiVector3D(100, 100, 100), aiQuaternion(), aiVector3D(0, 0, 0)) *
+      scene->mRootNode->mTransformation;
+  const fs::path file = dir_ / "figure_cm.assbin";
+  Assimp::Exporter exporter;
+  const aiReturn exported = exporter.Export(scene, "assbin", file.string());
+  delete scene;
+  ASSERT_EQ(exported, AI_SUCCESS) << exporter.GetErrorString();
+  const Avatar reference = ImportRiggedAvatar(figure_);
+  const Avatar cm = ImportRiggedAvatar(file);
+  EXPECT_NEAR(cm.params.height_m, reference.params.height_m, 0.005);
+  for (int j = 0; j < kJointCount; ++j) {
+    EXPECT_LT((cm.skeleton.bind_position[j] - reference.skeleton.bind_position[j]).norm(), 0.005)
+        << JointName(j);
+  }
+  ImportOptions options;
+  options.scale = 0.012;  // the caller's scale is taken as given
+  EXPECT_NEAR(ImportRiggedAvatar(file, options).params.height_m, 1.2 * reference.params.height_m,
+              0.01);
+}
+
+// Our own export (canonical joint names) imports without ../shared: the same
+// joints, the same height, the same truth markers; independent of the test
+// avatars beside the checkout.
+class OwnExportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = TempDir() / "own";
+    fs::create_directories(dir_);
+    person_ = LoadAvatar(fs::path(IRBENCH_SOURCE_DIR) / "avatars" / "p3.json");
+    glb_ = dir_ / "p3.glb";
+    WriteAvatarGlb(person_, glb_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_, glb_;
+  Avatar person_;
+};
+
+TEST_F(OwnExportTest, ImportsOntoTheSameSkeleton) {
+  Glb glb = ReadGlb(glb_);
+  std::vector<std::string> names;
+  for (const auto& node : glb.json["nodes"]) names.push_back(node.value("name", ""));
+  EXPECT_EQ(MapRigJoints(names, {}).convention, "irbench");
+
+  const Avatar imported = LoadAvatar(glb_);  // a mesh file is an avatar too
+  EXPECT_EQ(imported.params.kind, "mesh");
+  EXPECT_EQ(imported.params.name, "p3");
+  EXPECT_NEAR(imported.params.height_m, person_.params.height_m, 0.002);
+  // Above the hips the generator's T-pose is the canonical one: re-posing
+  // changes nothing beyond float rounding (the import puts the pelvis over the
+  // origin). The generator's legs converge slightly towards the ankles; the
+  // import straightens them to vertical, keeping the bone lengths.
+  const auto& ours = imported.skeleton.bind_position;
+  const auto& theirs = person_.skeleton.bind_position;
+  const Eigen::Vector3d shift(theirs[kPelvis].x(), theirs[kPelvis].y(), 0);
+  for (int j = 0; j < kJointCount; ++j) {
+    if (j == kRightKnee || j == kRightAnkle || j == kLeftKnee || j == kLeftAnkle) continue;
+    EXPECT_LT((ours[j] + shift - theirs[j]).norm(), 1e-4) << JointName(j);
+  }
+  for (int hip : {kRightHip, kLeftHip}) {
+    for (int j = hip; j < hip + 2; ++j) {
+      const Eigen::Vector3d bone = ours[j + 1] - ours[j];
+      EXPECT_NEAR(bone.norm(), (theirs[j + 1] - theirs[j]).norm(), 1e-4) << JointName(j);
+      EXPECT_LT(std::hypot(bone.x(), bone.y()), 1e-6) << JointName(j) << " not vertical";
+    }
+  }
+  EXPECT_EQ(imported.bind_vertices.size(), person_.bind_vertices.size());
+  EXPECT_EQ(imported.indices, person_.indices);
+  // Markers: head centre and hand tips within a few cm of the generator's.
+  for (const BoneMarker& m : person_.markers) {
+    bool found = false;
+    for (const BoneMarker& i : imported.markers) {
+      if (i.name != m.name) continue;
+      found = true;
+      EXPECT_EQ(i.joint, m.joint) << m.name;
+      EXPECT_LT((i.offset_in_joint - m.offset_in_joint).norm(), 0.04) << m.name;
+    }
+    EXPECT_TRUE(found) << m.name;
+  }
+}
+
+TEST_F(OwnExportTest, MeshAvatarFileCarriesTheImportOptions) {
+  const fs::path json = dir_ / "tall.json";
+  std::ofstream(json) << R"({"format": "irbench.avatar/1", "kind": "mesh", "name": "tall",
+    "file": "p3.glb", "scale": 1.1, "up_axis": "y", "style": {"handedness": "left"}})";
+  const Avatar tall = LoadAvatar(json);
+  EXPECT_EQ(tall.params.kind, "mesh");
+  EXPECT_EQ(tall.params.name, "tall");
+  EXPECT_NEAR(tall.params.height_m, 1.1 * person_.params.height_m, 0.003);
+  EXPECT_EQ(tall.params.style["handedness"], "left");
+
+  // Each bad field named in the avatar file (or, for the mesh, in the mesh).
+  struct Bad {
+    const char* json;
+    const char* file;  // "json" or "glb"
+    const char* field;
+  };
+  const Bad cases[] = {
+      {R"("file": "missing.glb")", "json", "file"},
+      {R"("file": "p3.glb", "scale": -1)", "json", "scale"},
+      {R"("file": "p3.glb", "up_axis": "x")", "json", "up_axis"},
+      {R"("file": "p3.glb", "height_m": 1.8)", "json", "height_m"},
+      {R"("file": "p3.glb", "joint_map": {"right_elbow": "nope"})", "json", "joint_map.right_elbow"},
+      {R"("file": "p3.glb", "joint_map": {"elbow": "right_elbow"})", "json", "joint_map.elbow"},
+      {R"("file": "p3.glb", "scale": 2)", "glb", "height"},
+  };
+  for (const Bad& b : cases) {
+    const fs::path bad = dir_ / "bad.json";
+    std::ofstream(bad) << R"({"format": "irbench.avatar/1", "kind": "mesh", )" << b.json << "}";
+    try {
+      LoadAvatar(bad);
+      ADD_FAILURE() << b.json << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), b.field) << e.what();
+      EXPECT_EQ(fs::path(e.file()).filename(), std::string(b.file) == "json" ? "bad.json" : "p3.glb")
+          << e.what();
+    }
+  }
+  // A tube avatar does not take import options.
+  const fs::path tube = dir_ / "tube.json";
+  std::ofstream(tube) << R"({"format": "irbench.avatar/1", "kind": "tube", "height_m": 1.7, "scale": 2})";
+  try {
+    LoadAvatar(tube);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "scale") << e.what();
   }
 }
 

@@ -63,6 +63,21 @@ std::string AvatarInfoText(const std::string& name_or_path) {
       << "watertight  " << (open == 0 ? "yes" : "no: " + std::to_string(open) + " edges not shared by two faces")
       << "\n"
       << "joints      " << kJointCount << " (canonical skeleton)\n";
+  if (a.params.source.is_object()) {
+    const nlohmann::json& src = a.params.source;
+    out << "imported    " << src["file"].get<std::string>() << "\n"
+        << "rig         " << src["convention"].get<std::string>() << " names, up " << src["up_axis"].get<std::string>()
+        << ", " << src["scale"].get<double>() << " m per file unit\n"
+        << "joint map   (canonical <- rig)\n";
+    for (int j = 0; j < kJointCount; ++j) {
+      const auto it = src["joint_map"].find(JointName(j));
+      out << "  " << JointName(j) << std::string(16 - std::min<size_t>(15, std::string(JointName(j)).size()), ' ')
+          << (it == src["joint_map"].end() ? std::string("(interpolated)") : it->get<std::string>()) << "\n";
+    }
+    std::string unmapped;
+    for (const auto& n : src["unmapped_rig_joints"]) unmapped += (unmapped.empty() ? "" : ", ") + n.get<std::string>();
+    out << "unmapped    " << (unmapped.empty() ? "none" : unmapped + " (follow their nearest mapped parent)") << "\n";
+  }
   return out.str();
 }
 

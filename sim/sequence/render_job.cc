@@ -189,6 +189,11 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
                         {"file", in.avatar_file.filename().string()},
                         {"kind", in.avatar.params.kind},
                         {"build", in.avatar.params.build}};
+  if (in.avatar.params.source.is_object()) {  // imported mesh: how its rig was read
+    nlohmann::json source = in.avatar.params.source;
+    source["file"] = fs::path(source["file"].get<std::string>()).filename().string();
+    manifest["avatar"]["source"] = source;
+  }
   manifest["motion"] = {{"name", in.motion_name},
                         {"file", in.motion_file.empty() ? nlohmann::json(nullptr)
                                                         : nlohmann::json(in.motion_file.filename().string())},
