@@ -13,6 +13,7 @@
 #include "sim/sequence/motion_tools.h"
 #include "sim/sequence/render_bench.h"
 #include "sim/sequence/render_job.h"
+#include "tracker/frontend/track_job.h"
 
 namespace {
 
@@ -56,8 +57,8 @@ irbench::GlBackend BackendOrThrow(const std::string& name) {
 
 int main(int argc, char** argv) {
   CLI::App app{"irbench: a test bench for multi-camera near-infrared body tracking.\n"
-               "Renders calibrated multi-camera sequences with exact truth (render);\n"
-               "more commands arrive with the tracker and the harness.",
+               "Renders calibrated multi-camera sequences with exact truth (render),\n"
+               "runs the tracker on them (track); more arrives with the tracker and the harness.",
                "irbench"};
   app.require_subcommand(1);
   app.set_version_flag("--version", irbench::ToolVersion());
@@ -83,6 +84,26 @@ int main(int argc, char** argv) {
                          "output folder (default: renders/<rig>-<avatar>-<motion>-s<seed>)");
   render_cmd->add_flag("--force", render.overwrite, "replace an existing output folder");
   render_cmd->add_flag("--depth", render.write_depth, "also write camera depth as OpenEXR");
+
+  // track
+  irbench::TrackJobOptions track;
+  std::string track_sequence, track_out;
+  int track_frames = 0;
+  bool track_keep_shadows = false;
+  CLI::App* track_cmd = app.add_subcommand(
+      "track", "Run the tracker on a sequence folder (frames, calibration and empty-stage frames only)");
+  track_cmd->add_option("SEQ", track_sequence, "sequence folder written by render")->required();
+  track_cmd->add_option("--stage", track.stage,
+                        "how far to go: features (silhouettes; more stages arrive with the tracker)")
+      ->capture_default_str();
+  track_cmd->add_option("--background-model", track.background_model,
+                        "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)")
+      ->capture_default_str();
+  track_cmd->add_flag("--keep-shadows", track_keep_shadows, "skip the edge-based shadow removal");
+  track_cmd->add_flag("--overlays", track.overlays, "also write debug overlays (PNG, colour)");
+  track_cmd->add_option("--frames", track_frames, "frames to process (default: all)");
+  track_cmd->add_option("--out", track_out, "output folder (default: SEQ/track)");
+  track_cmd->add_flag("--force", track.overwrite, "replace an existing output folder");
 
   // motion
   CLI::App* motion_cmd = app.add_subcommand("motion", "List, inspect and export motions");
@@ -156,6 +177,14 @@ int main(int argc, char** argv) {
       ApplyShadows(render_shadows, render);
       const std::filesystem::path folder = irbench::RunRenderJob(render);
       std::cout << folder.string() << "\n";
+      return kExitOk;
+    }
+    if (track_cmd->parsed()) {
+      track.sequence = track_sequence;
+      track.out = track_out;
+      track.remove_shadows = !track_keep_shadows;
+      if (track_cmd->count("--frames") > 0) track.frames = track_frames;
+      std::cout << irbench::RunTrackJob(track).string() << "\n";
       return kExitOk;
     }
     if (avatar_list->parsed()) {

@@ -59,7 +59,8 @@ TEST(CliTest, HelpOnEveryCommand) {
        {std::vector<std::string>{"--help"}, {"render", "--help"}, {"bench", "--help"},
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
         {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
-        {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"}}) {
+        {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
+        {"track", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
@@ -256,6 +257,57 @@ TEST(CliTest, RiggedMeshesAreAvatarsAndBadOnesAreRefused) {
     }
   }
   EXPECT_FALSE(fs::exists(dir / "seq"));
+}
+
+TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
+  const fs::path dir = FreshTempDir("cli_track");
+  ASSERT_EQ(RunIrbench({"render", "--rig", "lab4", "--frames", "2", "--background-frames", "4", "--sensor",
+                        "thesis", "--out", (dir / "seq").string()},
+                       dir)
+                .exit_code,
+            0);
+  const Result r = RunIrbench({"track", (dir / "seq").string(), "--stage", "features", "--overlays"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path track = dir / "seq" / "track";
+  EXPECT_EQ(r.out, track.string() + "\n");
+  std::ifstream lines(track / "features.jsonl");
+  std::string line;
+  int count = 0;
+  while (std::getline(lines, line)) {
+    const auto j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["frame"], count);
+    EXPECT_EQ(j["cameras"].size(), 4u);
+    for (const auto& [cam, c] : j["cameras"].items()) {
+      EXPECT_GT(c["silhouette_area"].get<int>(), 200) << cam;  // the person is in view
+      char name[32];
+      std::snprintf(name, sizeof(name), "%06d.png", count);
+      EXPECT_TRUE(fs::exists(track / "silhouettes" / cam / name));
+      EXPECT_TRUE(fs::exists(track / "overlays" / cam / name));
+    }
+    ++count;
+  }
+  EXPECT_EQ(count, 2);
+  // Again without --force: refused; a stage not built yet, a missing folder, a
+  // sequence without empty-stage frames: one line, exit 2, nothing left.
+  ASSERT_EQ(RunIrbench({"render", "--rig", "lab4", "--frames", "1", "--background-frames", "0", "--out",
+                        (dir / "nobg").string()},
+                       dir)
+                .exit_code,
+            0);
+  for (const auto& [args, expected] :
+       {std::pair<std::vector<std::string>, std::string>{{"track", (dir / "seq").string()}, "exists"},
+        {{"track", (dir / "seq").string(), "--stage", "pose", "--out", (dir / "t2").string()}, "--stage"},
+        {{"track", (dir / "seq").string(), "--background-model", "mog", "--out", (dir / "t3").string()},
+         "--background-model"},
+        {{"track", (dir / "missing").string()}, "no such sequence folder"},
+        {{"track", (dir / "nobg").string()}, "no empty-stage frames"}}) {
+    const Result bad = RunIrbench(args, dir);
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+    EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
+  }
+  for (const char* name : {"t2", "t3"}) EXPECT_FALSE(fs::exists(dir / name));
+  EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

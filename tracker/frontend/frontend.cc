@@ -1,0 +1,54 @@
+#include "tracker/frontend/frontend.h"
+
+#include <chrono>
+
+#include "common/error.h"
+
+namespace irbench {
+
+void FrontEndOptions::Check() const {
+  background.Check();
+  shadow.Check();
+}
+
+FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& options) {
+  options.Check();
+  if (input.background_count() == 0) {
+    throw InputError((input.dir() / "background").string(), "",
+                     "no empty-stage frames: the background model needs them (render with --background-frames)");
+  }
+  FrontEnd fe;
+  fe.options_ = options;
+  for (size_t c = 0; c < input.cameras().size(); ++c) {
+    const std::vector<cv::Mat> frames = input.Backgrounds(static_cast<int>(c));
+    auto model = BackgroundModel::Train(frames, options.background);
+    auto shadows = ShadowRemover::Train(frames, options.shadow);
+    if (!model || !shadows) {
+      throw InputError(input.BackgroundPath(static_cast<int>(c), 0).string(), "",
+                       "empty-stage frames differ in size or type");
+    }
+    fe.background_.push_back(std::move(*model));
+    fe.shadows_.push_back(std::move(*shadows));
+  }
+  return fe;
+}
+
+FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) const {
+  const auto start = std::chrono::steady_clock::now();
+  FrameFeatures out;
+  out.frame = frame;
+  for (size_t c = 0; c < background_.size(); ++c) {
+    const SilhouetteResult r = background_[c].Segment(frames.at(c));
+    CameraFeatures cf;
+    cf.before_shadows = r.mask;
+    cf.silhouette = options_.remove_shadows ? shadows_[c].Remove(frames[c], r.mask) : r.mask;
+    cf.light_level = r.light_level;
+    cf.blobs_removed = r.blobs_removed;
+    out.cameras.push_back(std::move(cf));
+  }
+  out.ms_silhouettes =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace irbench

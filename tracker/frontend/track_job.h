@@ -1,0 +1,36 @@
+#pragma once
+// `irbench track SEQ --stage features`: runs the front end over a sequence and
+// writes what it found, for inspection and for the later stages.
+//
+//   <out>/features.jsonl           a line per frame: per camera the silhouette's
+//                                  area, the light level, blobs removed; ms per stage
+//   <out>/silhouettes/<cam>/NNNNNN.png   255 person, 0 else
+//   <out>/overlays/<cam>/NNNNNN.png      (--overlays) the frame with the
+//                                  silhouette outline (green) and the pixels
+//                                  shadow removal took away (red)
+//
+// The output folder appears only when complete (StagingDir).
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "tracker/frontend/frontend.h"
+
+namespace irbench {
+
+struct TrackJobOptions {
+  std::filesystem::path sequence;
+  std::filesystem::path out;  // default: <sequence>/track
+  std::string stage = "features";
+  std::string background_model = "flicker";  // or "plain" (thesis 3.1)
+  bool remove_shadows = true;
+  bool overlays = false;
+  std::optional<int> frames;  // default: all
+  bool overwrite = false;
+};
+
+// Returns the output folder. Throws InputError on bad options or input.
+std::filesystem::path RunTrackJob(const TrackJobOptions& options);
+
+}  // namespace irbench

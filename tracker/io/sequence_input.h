@@ -1,0 +1,47 @@
+#pragma once
+// What the tracker reads of a sequence folder: the calibration
+// (calib/intri.yml, calib/extri.yml: OpenCV FileStorage, EasyMocap layout;
+// image sizes and fps from calib/cameras.json), the empty-stage frames
+// (background/<cam>/) and the frames (frames/<cam>/). Never truth/ and never the
+// manifest (which names the avatar and motion): a real rig has neither.
+
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/camera/camera.h"
+
+namespace irbench {
+
+class SequenceInput {
+ public:
+  // Throws InputError naming the file and field: a missing or unreadable
+  // calibration, a camera without frames, cameras with different frame counts.
+  static SequenceInput Open(const std::filesystem::path& dir);
+
+  const std::filesystem::path& dir() const { return dir_; }
+  const std::vector<Camera>& cameras() const { return cameras_; }
+  int frame_count() const { return frame_count_; }
+  int background_count() const { return background_count_; }
+  double fps() const { return cameras_.empty() ? 30.0 : cameras_.front().fps; }
+
+  // 8-bit single-channel images (16-bit frames are scaled to 8 bits). Throws
+  // InputError for an unreadable file or one of the wrong size.
+  cv::Mat Frame(int camera, int frame) const;
+  cv::Mat Background(int camera, int index) const;
+  std::vector<cv::Mat> Backgrounds(int camera) const;
+
+  std::filesystem::path FramePath(int camera, int frame) const;
+  std::filesystem::path BackgroundPath(int camera, int index) const;
+
+ private:
+  cv::Mat Load(const std::filesystem::path& path, int camera) const;
+
+  std::filesystem::path dir_;
+  std::vector<Camera> cameras_;
+  int frame_count_ = 0;
+  int background_count_ = 0;
+};
+
+}  // namespace irbench

@@ -1,0 +1,205 @@
+#include "tracker/silhouette/background_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace irbench {
+
+void BackgroundOptions::Check() const {
+  if (model != "flicker" && model != "plain") {
+    throw std::invalid_argument("background model: must be flicker or plain, not '" + model + "'");
+  }
+  if (!(threshold_sigma > 0)) throw std::invalid_argument("background threshold_sigma: must be > 0");
+  if (!(pool_sigma >= 0 && pool_threshold > 0)) {
+    throw std::invalid_argument("background pool_sigma: must be >= 0, pool_threshold > 0");
+  }
+  if (!(min_sigma >= 0)) throw std::invalid_argument("background min_sigma: must be >= 0");
+  if (open_radius < 0 || close_radius < 0) throw std::invalid_argument("background morphology radii: must be >= 0");
+  if (!(min_blob_fraction >= 0 && min_blob_fraction < 1)) {
+    throw std::invalid_argument("background min_blob_fraction: must be in [0, 1)");
+  }
+}
+
+std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>& frames,
+                                                      const BackgroundOptions& options) {
+  options.Check();
+  if (frames.empty()) return std::nullopt;
+  const cv::Size size = frames[0].size();
+  for (const cv::Mat& f : frames) {
+    if (f.size() != size || f.type() != CV_8UC1) return std::nullopt;
+  }
+  const int n = static_cast<int>(frames.size());
+  std::vector<double> light(n);
+  for (int i = 0; i < n; ++i) light[i] = cv::mean(frames[i])[0];
+  double light_mean = 0;
+  for (double l : light) light_mean += l / n;
+  double light_var = 0;
+  for (double l : light) light_var += (l - light_mean) * (l - light_mean) / n;
+
+  BackgroundModel m;
+  m.options_ = options;
+  m.mean_light_ = light_mean;
+  cv::Mat sum = cv::Mat::zeros(size, CV_64F), sum_l = cv::Mat::zeros(size, CV_64F);
+  for (int i = 0; i < n; ++i) {
+    cv::Mat f;
+    frames[i].convertTo(f, CV_64F);
+    sum += f;
+    sum_l += f * (light[i] - light_mean);
+  }
+  const cv::Mat mean = sum / n;
+  // With (almost) no light change in training, b is not identifiable: plain.
+  const bool flicker = options.model == "flicker";
+  const bool regress = flicker && light_var > 0.05 && n >= 3;
+  cv::Mat b = regress ? cv::Mat(sum_l / (n * light_var))
+              : flicker && light_mean > 1 ? cv::Mat(mean / light_mean)
+                                          : cv::Mat::zeros(size, CV_64F);
+  cv::Mat a = mean - b * light_mean;
+  cv::Mat sq = cv::Mat::zeros(size, CV_64F);
+  for (int i = 0; i < n; ++i) {
+    cv::Mat f;
+    frames[i].convertTo(f, CV_64F);
+    cv::Mat r = f - (a + b * light[i]);
+    sq += r.mul(r);
+  }
+  const int dof = std::max(1, n - (regress ? 2 : 1));
+  cv::Mat sigma;
+  cv::sqrt(sq / dof, sigma);
+  a.convertTo(m.a_, CV_32F);
+  b.convertTo(m.b_, CV_32F);
+  sigma = cv::max(sigma, options.min_sigma);
+  sigma.convertTo(m.sigma_, CV_32F);
+  // Light is read from pixels that follow it clearly: b well above its noise.
+  m.light_pixels_ = cv::Mat::zeros(size, CV_8U);
+  if (flicker && !regress) m.light_pixels_ = m.b_ > 0.2;
+  if (regress) {
+    for (int y = 0; y < size.height; ++y) {
+      const float* bp = m.b_.ptr<float>(y);
+      const float* sp = m.sigma_.ptr<float>(y);
+      uint8_t* lp = m.light_pixels_.ptr<uint8_t>(y);
+      for (int x = 0; x < size.width; ++x) {
+        // b's standard error is σ / (sqrt(n) · std(L)).
+        lp[x] = bp[x] > 0.2 && bp[x] > 3 * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
+      }
+    }
+  }
+  // The pooled difference's noise, measured where it is used.
+  if (flicker && options.pool_sigma > 0) {
+    double sum_sq = 0;
+    size_t count = 0;
+    for (int i = 0; i < n; ++i) {
+      cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])));
+      cv::GaussianBlur(z, z, cv::Size(), m.PoolSigmaPx(size.width));
+      sum_sq += z.dot(z);
+      count += z.total();
+    }
+    // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
+    m.pooled_noise_ = std::max(1e-3, std::sqrt(sum_sq / count * n / dof));
+  }
+  return m;
+}
+
+cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light) const {
+  cv::Mat z(frame.size(), CV_32F);
+  for (int y = 0; y < frame.rows; ++y) {
+    const uint8_t* ip = frame.ptr<uint8_t>(y);
+    const float* ap = a_.ptr<float>(y);
+    const float* bp = b_.ptr<float>(y);
+    const float* sp = sigma_.ptr<float>(y);
+    float* zp = z.ptr<float>(y);
+    for (int x = 0; x < frame.cols; ++x) zp[x] = (ip[x] - (ap[x] + bp[x] * light)) / sp[x];
+  }
+  return z;
+}
+
+cv::Mat BackgroundModel::Expected(double light) const {
+  cv::Mat e = a_ + b_ * light;
+  return e;
+}
+
+double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
+  if (cv::countNonZero(light_pixels_) < 50) return mean_light_;
+  std::vector<float> estimates;
+  estimates.reserve(static_cast<size_t>(cv::countNonZero(light_pixels_)));
+  for (int y = 0; y < frame.rows; ++y) {
+    const uint8_t* ip = frame.ptr<uint8_t>(y);
+    const uint8_t* lp = light_pixels_.ptr<uint8_t>(y);
+    const float* ap = a_.ptr<float>(y);
+    const float* bp = b_.ptr<float>(y);
+    for (int x = 0; x < frame.cols; ++x) {
+      if (lp[x]) estimates.push_back((ip[x] - ap[x]) / bp[x]);
+    }
+  }
+  auto mid = estimates.begin() + static_cast<std::ptrdiff_t>(estimates.size() / 2);
+  std::nth_element(estimates.begin(), mid, estimates.end());
+  return *mid;
+}
+
+SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
+  CV_Assert(frame.type() == CV_8UC1 && frame.size() == a_.size());
+  SilhouetteResult r;
+  r.light_level = options_.model == "flicker" ? EstimateLight(frame) : mean_light_;
+  const cv::Mat z = Normalised(frame, static_cast<float>(r.light_level));
+  r.raw = cv::abs(z) > options_.threshold_sigma;
+  if (options_.model == "flicker" && options_.pool_sigma > 0) {
+    cv::Mat pooled;
+    cv::GaussianBlur(z, pooled, cv::Size(), PoolSigmaPx(frame.cols));
+    // Hysteresis: weak pooled evidence counts where it connects to strong.
+    const cv::Mat strong = (cv::abs(pooled) > options_.pool_threshold * pooled_noise_) | r.raw;
+    const cv::Mat weak = (cv::abs(pooled) > options_.pool_weak_threshold * pooled_noise_) | strong;
+    cv::Mat labels;
+    const int count = cv::connectedComponents(weak, labels, 8, CV_32S);
+    std::vector<uint8_t> keep(count, 0);
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* lp = labels.ptr<int>(y);
+      const uint8_t* sp = strong.ptr<uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) {
+        if (sp[x]) keep[lp[x]] = 1;
+      }
+    }
+    keep[0] = 0;
+    cv::Mat grown(labels.size(), CV_8U);
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* lp = labels.ptr<int>(y);
+      uint8_t* out = grown.ptr<uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) out[x] = keep[lp[x]] ? 255 : 0;
+    }
+    // Pooling spreads a region by about the window's radius: take it back.
+    const int r_px = std::max(1, static_cast<int>(std::lround(PoolSigmaPx(frame.cols))));
+    cv::erode(grown, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r_px + 1, 2 * r_px + 1)));
+    r.raw |= grown;
+  }
+  r.mask = r.raw.clone();
+  const double scale = frame.cols / 320.0;
+  r.blobs_removed = CleanMask(r.mask, static_cast<int>(std::lround(options_.open_radius * scale)),
+                              static_cast<int>(std::lround(options_.close_radius * scale)),
+                              static_cast<int>(options_.min_blob_fraction * frame.total()));
+  return r;
+}
+
+int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area) {
+  auto kernel = [](int r) {
+    return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+  };
+  if (open_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_OPEN, kernel(open_radius));
+  if (close_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, kernel(close_radius));
+  if (min_area <= 1) return 0;
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<uint8_t> keep(count, 0);
+  int removed = 0;
+  for (int i = 1; i < count; ++i) {
+    keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_area;
+    removed += !keep[i];
+  }
+  if (removed == 0) return 0;
+  for (int y = 0; y < mask.rows; ++y) {
+    const int* lp = labels.ptr<int>(y);
+    uint8_t* mp = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < mask.cols; ++x) mp[x] = keep[lp[x]] ? 255 : 0;
+  }
+  return removed;
+}
+
+}  // namespace irbench
