@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sim/sequence/render_job.h"
 #include "tests/test_util.h"
+#include "tracker/frontend/frontend.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/silhouette/background_model.h"
 #include "tracker/silhouette/shadow_removal.h"
@@ -58,7 +60,7 @@ fs::path RenderThesis(const fs::path& dir, const std::string& person, int frames
 TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
   const fs::path dir = FreshTempDir("frontend_silhouettes");
   std::vector<double> iou_flicker, iou_plain, iou_raw;
-  long fp_before = 0, fp_after = 0, body_before = 0, body_after = 0;
+  long fp_before = 0, fp_after = 0, body_before = 0, body_after = 0, truth_pixels = 0;
   for (const std::string person : {"p1", "p2", "p3", "p4", "p5"}) {
     const fs::path seq = RenderThesis(dir, person, 4);
     const SequenceInput in = SequenceInput::Open(seq);
@@ -74,15 +76,18 @@ TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
       for (int f = 0; f < in.frame_count(); ++f) {
         const cv::Mat frame = in.Frame(cam, f);
         const cv::Mat truth = TruthMask(seq, in.cameras()[c].name, f);
-        const cv::Mat sil = flicker->Segment(frame).mask;
-        const cv::Mat cleaned = shadows->Remove(frame, sil);
+        const SilhouetteResult r = flicker->Segment(frame);
+        const cv::Mat& sil = r.mask;
+        const cv::Mat cleaned = shadows->Remove(frame, sil, r.darker);
         iou_raw.push_back(IoU(sil, truth));
         iou_flicker.push_back(IoU(cleaned, truth));
-        iou_plain.push_back(IoU(shadows->Remove(frame, plain->Segment(frame).mask), truth));
+        const SilhouetteResult rp = plain->Segment(frame);
+        iou_plain.push_back(IoU(shadows->Remove(frame, rp.mask, rp.darker), truth));
         fp_before += cv::countNonZero(sil & ~truth);
         fp_after += cv::countNonZero(cleaned & ~truth);
         body_before += cv::countNonZero(sil & truth);
         body_after += cv::countNonZero(cleaned & truth);
+        truth_pixels += cv::countNonZero(truth);
       }
     }
     fs::remove_all(seq);
@@ -90,18 +95,95 @@ TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
   std::printf("silhouette IoU, median over %zu camera-frames: flicker model %.3f (before shadow removal %.3f), "
               "thesis plain model %.3f\n",
               iou_flicker.size(), Median(iou_flicker), Median(iou_raw), Median(iou_plain));
+  std::printf("truth pixels %ld: found %ld (%.1f%%), false foreground after %ld (%.1f%% of truth)\n", truth_pixels,
+              body_after, 100.0 * body_after / std::max(1L, truth_pixels), fp_after,
+              100.0 * fp_after / std::max(1L, truth_pixels));
   std::printf("false foreground pixels %ld -> %ld (%.0f%% fewer); body pixels lost %.2f%%\n", fp_before, fp_after,
               100.0 * (1 - double(fp_after) / std::max(1L, fp_before)),
               100.0 * (1 - double(body_after) / std::max(1L, body_before)));
-  // Floors under today's figures (0.740, plain 0.423; 66% fewer false
-  // foreground pixels, 8.2% of the body lost), so a regression fails. The
-  // issue's bars — median IoU 0.92, shadows down 70% with at most 3% of the
-  // body lost — are not met yet: clothing as grey as the wall behind it, and
-  // the thesis preset's defocus blur, cost most of the difference.
-  EXPECT_GE(Median(iou_flicker), 0.70);
+  // Floors under today's figures (median IoU 0.777, plain 0.496; 65% fewer
+  // false-foreground pixels with 1.5% of the body lost), so a regression
+  // fails. The issue's bars — median IoU 0.92, shadows down 70% — are not met
+  // yet: clothing as grey as the wall behind it (p2's trousers) cannot be told
+  // from the wall by intensity, and the preset's defocus blurs the outline.
+  EXPECT_GE(Median(iou_flicker), 0.74);
   EXPECT_GE(Median(iou_flicker) - Median(iou_plain), 0.2);
   EXPECT_LE(double(fp_after), 0.45 * double(fp_before));
-  EXPECT_LE(1 - double(body_after) / std::max(1L, body_before), 0.11);
+  EXPECT_LE(1 - double(body_after) / std::max(1L, body_before), 0.03);
+}
+
+Eigen::Vector3d Joint(const nlohmann::json& frame, const std::string& name) {
+  const auto& j = frame["joints3d"][name];
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+double DistanceToSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double s = std::clamp((p - a).dot(b - a) / std::max(1e-12, (b - a).squaredNorm()), 0.0, 1.0);
+  return (a + s * (b - a) - p).norm();
+}
+
+// The whole front end on the thesis preset — silhouettes from the background
+// model, shadows removed, 2D axes, body parts, 3D axis points — while an arm
+// is raised: the 3D arm points against the true arm bones (issue bar: median
+// within 4 cm).
+TEST(FrontendClosedLoopTest, ArmAxisFromThesisSilhouettes) {
+  const fs::path dir = FreshTempDir("frontend_axes");
+  std::vector<double> distances;
+  for (const auto& [person, motion] : {std::pair<std::string, std::string>{"p1", "raise_overhead"},
+                                       {"p3", "flap_both"}}) {
+    RenderJobOptions options;
+    options.rig = "theater4";
+    options.avatar = person;
+    options.motion = motion;
+    options.sensor = "thesis";
+    options.frames = 34;
+    options.background_frames = 12;
+    options.seed = 3;
+    options.out = dir / person;
+    const fs::path seq = RunRenderJob(options);
+    const SequenceInput in = SequenceInput::Open(seq);
+    const FrontEnd front_end = FrontEnd::Train(in, {});
+    std::ifstream truth(seq / "truth/frames.jsonl");
+    int frames = 0, total_arm_points = 0;
+    for (std::string line; std::getline(truth, line);) {
+      const auto frame = nlohmann::json::parse(line);
+      const int f = frame["frame"];
+      bool raised = false;
+      for (const std::string side : {"left", "right"}) {
+        raised |= Joint(frame, side + "_wrist").z() > Joint(frame, side + "_shoulder").z() - 0.1;
+      }
+      if (!raised || f % 3 != 0) continue;
+      std::vector<cv::Mat> images;
+      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const FrameFeatures features = front_end.Process(f, images);
+      int arm_points = 0;
+      for (const AxisPoint3d& p : features.axis3d) {
+        if (p.part != BodyPart::kArm) continue;
+        double nearest = 1e9;
+        for (const std::string side : {"left", "right"}) {
+          nearest = std::min({nearest,
+                              DistanceToSegment(p.p_in_world, Joint(frame, side + "_shoulder"), Joint(frame, side + "_elbow")),
+                              DistanceToSegment(p.p_in_world, Joint(frame, side + "_elbow"), Joint(frame, side + "_wrist")),
+                              DistanceToSegment(p.p_in_world, Joint(frame, side + "_wrist"), Joint(frame, side + "_hand_tip"))});
+        }
+        distances.push_back(nearest);
+        ++arm_points;
+      }
+      total_arm_points += arm_points;
+      ++frames;
+    }
+    EXPECT_GE(frames, 3) << person;
+    // Some views lose a forearm against the wall; most frames keep plenty.
+    EXPECT_GT(total_arm_points, 8 * frames) << person;
+    fs::remove_all(seq);
+  }
+  std::sort(distances.begin(), distances.end());
+  ASSERT_FALSE(distances.empty());
+  const double median = distances[distances.size() / 2], p90 = distances[distances.size() * 9 / 10];
+  std::printf("3D arm axis points from thesis-preset silhouettes: %zu points, distance to the true arm bones "
+              "median %.1f mm, p90 %.1f mm\n",
+              distances.size(), 1000 * median, 1000 * p90);
+  EXPECT_LE(median, 0.04);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@ namespace irbench {
 void FrontEndOptions::Check() const {
   background.Check();
   shadow.Check();
+  axes.Check();
 }
 
 FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& options) {
@@ -19,6 +20,7 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
   }
   FrontEnd fe;
   fe.options_ = options;
+  fe.cameras_ = input.cameras();
   for (size_t c = 0; c < input.cameras().size(); ++c) {
     const std::vector<cv::Mat> frames = input.Backgrounds(static_cast<int>(c));
     auto model = BackgroundModel::Train(frames, options.background);
@@ -41,13 +43,20 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
     const SilhouetteResult r = background_[c].Segment(frames.at(c));
     CameraFeatures cf;
     cf.before_shadows = r.mask;
-    cf.silhouette = options_.remove_shadows ? shadows_[c].Remove(frames[c], r.mask) : r.mask;
+    cf.silhouette = options_.remove_shadows ? shadows_[c].Remove(frames[c], r.mask, r.darker) : r.mask;
     cf.light_level = r.light_level;
     cf.blobs_removed = r.blobs_removed;
     out.cameras.push_back(std::move(cf));
   }
-  out.ms_silhouettes =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const auto silhouettes_done = std::chrono::steady_clock::now();
+  out.ms_silhouettes = std::chrono::duration<double, std::milli>(silhouettes_done - start).count();
+  if (options_.find_axes) {
+    std::vector<cv::Mat> silhouettes;
+    for (const CameraFeatures& cf : out.cameras) silhouettes.push_back(cf.silhouette);
+    out.axis3d = ReconstructBodyAxes(cameras_, silhouettes, options_.axes, &out.views);
+    out.ms_axes =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - silhouettes_done).count();
+  }
   return out;
 }
 

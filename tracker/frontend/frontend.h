@@ -1,12 +1,14 @@
 #pragma once
-// The tracker's front end per frame-set (thesis ch. 3): for every camera, the
-// silhouette from its background model, cleaned of shadows. Trained from the
+// The tracker's front end per frame-set (thesis ch. 3-4): for every camera, the
+// silhouette from its background model, cleaned of shadows; the 2D axis points
+// and body parts; across cameras, the 3D axis points. Trained from the
 // sequence's empty-stage frames only.
 
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "tracker/axis/axis3d.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/silhouette/background_model.h"
 #include "tracker/silhouette/shadow_removal.h"
@@ -17,6 +19,8 @@ struct FrontEndOptions {
   BackgroundOptions background;
   ShadowOptions shadow;
   bool remove_shadows = true;
+  BodyAxesOptions axes;  // 2D axis points, body parts, 3D axis points
+  bool find_axes = true;
   void Check() const;  // throws std::invalid_argument
 };
 
@@ -30,7 +34,12 @@ struct CameraFeatures {
 struct FrameFeatures {
   int frame = 0;
   std::vector<CameraFeatures> cameras;
-  double ms_silhouettes = 0;  // wall time of this stage for all cameras
+  // Per camera: the 2D axis graph and part labels (thesis 3.2-3.3).
+  std::vector<AxisView> views;
+  // 3D axis points by epipolar intersection (thesis 4.4.2).
+  std::vector<AxisPoint3d> axis3d;
+  double ms_silhouettes = 0;  // wall time of each stage for all cameras
+  double ms_axes = 0;
 };
 
 class FrontEnd {
@@ -46,6 +55,7 @@ class FrontEnd {
   FrontEndOptions options_;
   std::vector<BackgroundModel> background_;
   std::vector<ShadowRemover> shadows_;
+  std::vector<Camera> cameras_;
 };
 
 }  // namespace irbench

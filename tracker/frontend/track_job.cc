@@ -1,6 +1,9 @@
 #include "tracker/frontend/track_job.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -26,14 +29,52 @@ void WritePng(const fs::path& path, const cv::Mat& image) {
   AtomicWriteFile(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
-cv::Mat Overlay(const cv::Mat& frame, const CameraFeatures& f) {
+cv::Scalar PartColour(BodyPart part) {
+  switch (part) {
+    case BodyPart::kHead: return {0, 230, 230};           // yellow
+    case BodyPart::kTorso: return {230, 120, 0};          // blue
+    case BodyPart::kLeftImageArm: return {230, 0, 230};   // magenta
+    case BodyPart::kRightImageArm: return {230, 230, 0};  // cyan
+    case BodyPart::kArm: return {230, 230, 0};
+    default: return {140, 140, 140};
+  }
+}
+
+cv::Mat Overlay(const cv::Mat& frame, const CameraFeatures& f, const AxisView* view,
+                const std::vector<AxisPoint3d>& axis3d) {
   cv::Mat out;
   cv::cvtColor(frame, out, cv::COLOR_GRAY2BGR);
   out.setTo(cv::Scalar(0, 0, 200), f.before_shadows & ~f.silhouette);
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(f.silhouette.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   cv::drawContours(out, contours, -1, cv::Scalar(0, 220, 0), 1);
+  if (view) {
+    for (size_t i = 0; i < view->graph.points.size(); ++i) {
+      const BodyPart part = i < view->labels.size() ? view->labels[i] : BodyPart::kNone;
+      if (part == BodyPart::kNone) continue;
+      const Eigen::Vector2d& p = view->graph.points[i].px;
+      out.at<cv::Vec3b>(std::clamp(int(std::lround(p.y())), 0, out.rows - 1),
+                        std::clamp(int(std::lround(p.x())), 0, out.cols - 1)) =
+          cv::Vec3b(PartColour(part)[0], PartColour(part)[1], PartColour(part)[2]);
+    }
+    // The 3D axis points projected back: white crosses.
+    for (const AxisPoint3d& a : axis3d) {
+      const Eigen::Vector3d p_in_cam = view->camera.cam_from_world * a.p_in_world;
+      if (p_in_cam.z() <= 0) continue;
+      const Eigen::Vector2d px = view->camera.Project(a.p_in_world);
+      cv::drawMarker(out, cv::Point(int(std::lround(px.x())), int(std::lround(px.y()))), {255, 255, 255},
+                     cv::MARKER_CROSS, 3, 1);
+    }
+  }
   return out;
+}
+
+const char* Part3dName(BodyPart part) {
+  switch (part) {
+    case BodyPart::kHead: return "head";
+    case BodyPart::kTorso: return "torso";
+    default: return "arm";
+  }
 }
 
 }  // namespace
@@ -84,14 +125,37 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     for (size_t c = 0; c < input.cameras().size(); ++c) {
       const std::string& name = input.cameras()[c].name;
       const CameraFeatures& cf = features.cameras[c];
+      std::map<std::string, int> parts;
+      if (c < features.views.size()) {
+        const AxisView& v = features.views[c];
+        int kept = 0;
+        for (const AxisPoint2d& p : v.graph.points) kept += p.kept;
+        parts["axis_points"] = kept;
+        for (BodyPart b : v.labels) {
+          if (b != BodyPart::kNone) ++parts[BodyPartName(b)];
+        }
+      }
       line["cameras"][name] = {{"silhouette_area", cv::countNonZero(cf.silhouette)},
+                               {"axis", parts},
                                {"shadow_pixels_removed", cv::countNonZero(cf.before_shadows & ~cf.silhouette)},
                                {"light_level", cf.light_level},
                                {"blobs_removed", cf.blobs_removed}};
       WritePng(root / "silhouettes" / name / FrameName(f), cf.silhouette);
-      if (options.overlays) WritePng(root / "overlays" / name / FrameName(f), Overlay(images[c], cf));
+      if (options.overlays) {
+        const AxisView* view = c < features.views.size() ? &features.views[c] : nullptr;
+        WritePng(root / "overlays" / name / FrameName(f), Overlay(images[c], cf, view, features.axis3d));
+      }
     }
-    line["ms"] = {{"silhouettes", features.ms_silhouettes}};
+    nlohmann::json axis3d = nlohmann::json::array();
+    for (const AxisPoint3d& a : features.axis3d) {
+      axis3d.push_back({{"p", {std::round(a.p_in_world.x() * 1e4) / 1e4, std::round(a.p_in_world.y() * 1e4) / 1e4,
+                               std::round(a.p_in_world.z() * 1e4) / 1e4}},
+                        {"part", Part3dName(a.part)},
+                        {"diameter_m", std::round(a.diameter_m * 1e4) / 1e4},
+                        {"support", a.support}});
+    }
+    line["axis3d"] = axis3d;
+    line["ms"] = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes}};
     lines += line.dump() + "\n";
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {

@@ -142,6 +142,11 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   r.light_level = options_.model == "flicker" ? EstimateLight(frame) : mean_light_;
   const cv::Mat z = Normalised(frame, static_cast<float>(r.light_level));
   r.raw = cv::abs(z) > options_.threshold_sigma;
+  {
+    cv::Mat smooth;
+    cv::GaussianBlur(z, smooth, cv::Size(), 1.5 * frame.cols / 320.0);
+    r.darker = smooth < 0;
+  }
   if (options_.model == "flicker" && options_.pool_sigma > 0) {
     cv::Mat pooled;
     cv::GaussianBlur(z, pooled, cv::Size(), PoolSigmaPx(frame.cols));

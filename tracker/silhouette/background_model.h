@@ -48,6 +48,7 @@ struct BackgroundOptions {
 struct SilhouetteResult {
   cv::Mat mask;            // CV_8UC1, 255 foreground
   cv::Mat raw;             // before morphology and blob removal
+  cv::Mat darker;          // 255 where the frame is darker than the expected stage (smoothed)
   double light_level = 0;  // L(t) (flicker model); the training mean for "plain"
   int blobs_removed = 0;
 };

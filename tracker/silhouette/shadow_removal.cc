@@ -63,11 +63,13 @@ cv::Mat ShadowRemover::SegmentedEdges(const cv::Mat& frame, const cv::Mat& silho
   return edges;
 }
 
-cv::Mat ShadowRemover::Remove(const cv::Mat& frame, const cv::Mat& silhouette) const {
+cv::Mat ShadowRemover::Remove(const cv::Mat& frame, const cv::Mat& silhouette, const cv::Mat& darker) const {
   const cv::Mat edges = SegmentedEdges(frame, silhouette);
   const double scale = frame.cols / 320.0;
-  return KeepEnclosed(silhouette, edges, options_.min_directions,
-                      static_cast<int>(std::lround(options_.edge_reach * scale)));
+  cv::Mat kept = KeepEnclosed(silhouette, edges, options_.min_directions,
+                              static_cast<int>(std::lround(options_.edge_reach * scale)));
+  if (!darker.empty()) kept.setTo(255, silhouette & ~darker);
+  return kept;
 }
 
 cv::Mat KeepEnclosed(const cv::Mat& silhouette, const cv::Mat& edges, int min_directions, int reach) {

@@ -38,8 +38,10 @@ class ShadowRemover {
   // The frame's edges (CV_8U 0/255) not in the background, dilated, inside the
   // silhouette dilated by the reach.
   cv::Mat SegmentedEdges(const cv::Mat& frame, const cv::Mat& silhouette) const;
-  // The silhouette with the shadow pixels removed.
-  cv::Mat Remove(const cv::Mat& frame, const cv::Mat& silhouette) const;
+  // The silhouette with the shadow pixels removed. A shadow only darkens: when
+  // `darker` (255 where the frame is darker than the empty stage) is given,
+  // silhouette pixels outside it are body whatever the edges say.
+  cv::Mat Remove(const cv::Mat& frame, const cv::Mat& silhouette, const cv::Mat& darker = cv::Mat()) const;
 
   const cv::Mat& background_edges() const { return background_edges_; }
 
