@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "cli/bench_track.h"
 #include "common/cancel.h"
 #include "common/error.h"
 #include "common/logging.h"
@@ -154,6 +155,17 @@ int main(int argc, char** argv) {
   bench_render->add_option("--frames", bench_frames, "timed frame-sets per resolution")
       ->capture_default_str();
 
+  irbench::RenderJobOptions bench_track_render;
+  bench_track_render.sensor = "thesis";
+  std::string bench_track_backend = "auto", bench_track_shadows;
+  int bench_track_frames = 30, bench_track_repeats = 3;
+  CLI::App* bench_track = bench_cmd->add_subcommand(
+      "track", "Milliseconds per frame-set of the tracker's stages, on a sequence rendered for it\n"
+               "(images preloaded: decoding is not counted)");
+  AddRenderInputOptions(bench_track, bench_track_render, bench_track_backend, bench_track_shadows);
+  bench_track->add_option("--frames", bench_track_frames, "frame-sets to render and time")->capture_default_str();
+  bench_track->add_option("--repeats", bench_track_repeats, "passes over them")->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -209,6 +221,21 @@ int main(int argc, char** argv) {
     }
     if (motion_export->parsed()) {
       std::cout << irbench::ExportMotion(export_options).string() << "\n";
+      return kExitOk;
+    }
+    if (bench_track->parsed()) {
+      bench_track_render.backend = BackendOrThrow(bench_track_backend);
+      ApplyShadows(bench_track_shadows, bench_track_render);
+      if (bench_track_frames < 1) throw irbench::InputError("", "--frames", "must be at least 1");
+      if (bench_track_repeats < 1) throw irbench::InputError("", "--repeats", "must be at least 1");
+      int cameras = 0;
+      const auto rows = irbench::RunTrackBench(bench_track_render, bench_track_frames, bench_track_repeats, &cameras);
+      std::printf("# irbench bench track: rig %s, avatar %s, motion %s, sensor %s, %d cameras, %d frame-sets x %d\n",
+                  bench_track_render.rig.c_str(), bench_track_render.avatar.c_str(),
+                  bench_track_render.motion.c_str(), bench_track_render.sensor.c_str(), cameras,
+                  bench_track_frames, bench_track_repeats);
+      std::printf("| stage | median ms per frame-set | mean ms |\n|---|---|---|\n");
+      for (const auto& r : rows) std::printf("| %s | %.2f | %.2f |\n", r.stage.c_str(), r.median_ms, r.mean_ms);
       return kExitOk;
     }
     if (bench_render->parsed()) {

@@ -122,15 +122,17 @@ double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
   if (cv::countNonZero(light_pixels_) < 50) return mean_light_;
   std::vector<float> estimates;
   estimates.reserve(static_cast<size_t>(cv::countNonZero(light_pixels_)));
-  for (int y = 0; y < frame.rows; ++y) {
+  // Every other row and column: a quarter of the pixels is plenty for a median.
+  for (int y = 0; y < frame.rows; y += 2) {
     const uint8_t* ip = frame.ptr<uint8_t>(y);
     const uint8_t* lp = light_pixels_.ptr<uint8_t>(y);
     const float* ap = a_.ptr<float>(y);
     const float* bp = b_.ptr<float>(y);
-    for (int x = 0; x < frame.cols; ++x) {
+    for (int x = 0; x < frame.cols; x += 2) {
       if (lp[x]) estimates.push_back((ip[x] - ap[x]) / bp[x]);
     }
   }
+  if (estimates.empty()) return mean_light_;
   auto mid = estimates.begin() + static_cast<std::ptrdiff_t>(estimates.size() / 2);
   std::nth_element(estimates.begin(), mid, estimates.end());
   return *mid;

@@ -47,9 +47,13 @@ std::optional<ShadowRemover> ShadowRemover::Train(const std::vector<cv::Mat>& ba
 }
 
 cv::Mat ShadowRemover::SegmentedEdges(const cv::Mat& frame, const cv::Mat& silhouette) const {
+  return SegmentedEdges(frame, silhouette, background_edges_, frame.cols / 320.0);
+}
+
+cv::Mat ShadowRemover::SegmentedEdges(const cv::Mat& frame, const cv::Mat& silhouette,
+                                      const cv::Mat& background_edges, double scale) const {
   cv::Mat edges = Edges(frame);
-  edges.setTo(0, background_edges_);
-  const double scale = frame.cols / 320.0;
+  edges.setTo(0, background_edges);
   const int dilate = static_cast<int>(std::lround(options_.edge_dilate * scale));
   if (dilate > 0) {
     cv::dilate(edges, edges,
@@ -64,10 +68,20 @@ cv::Mat ShadowRemover::SegmentedEdges(const cv::Mat& frame, const cv::Mat& silho
 }
 
 cv::Mat ShadowRemover::Remove(const cv::Mat& frame, const cv::Mat& silhouette, const cv::Mat& darker) const {
-  const cv::Mat edges = SegmentedEdges(frame, silhouette);
+  cv::Mat kept = cv::Mat::zeros(silhouette.size(), CV_8U);
+  const cv::Rect box = cv::boundingRect(silhouette);
+  if (box.empty()) return kept;
+  // Work inside the silhouette's box, with room for the blur, the dilations
+  // and the reach; the result is the same as on the whole image.
   const double scale = frame.cols / 320.0;
-  cv::Mat kept = KeepEnclosed(silhouette, edges, options_.min_directions,
-                              static_cast<int>(std::lround(options_.edge_reach * scale)));
+  const int margin = static_cast<int>(std::ceil((4 * options_.blur_sigma + options_.edge_dilate +
+                                                 options_.edge_reach + 4) * scale));
+  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+                       cv::Rect(0, 0, frame.cols, frame.rows);
+  const cv::Mat edges = SegmentedEdges(frame(roi), silhouette(roi), background_edges_(roi), scale);
+  KeepEnclosed(silhouette(roi), edges, options_.min_directions,
+               static_cast<int>(std::lround(options_.edge_reach * scale)))
+      .copyTo(kept(roi));
   if (!darker.empty()) kept.setTo(255, silhouette & ~darker);
   return kept;
 }

@@ -47,6 +47,9 @@ class ShadowRemover {
 
  private:
   cv::Mat Edges(const cv::Mat& frame) const;
+  // On a region of the image: `scale` is the full image's width / 320.
+  cv::Mat SegmentedEdges(const cv::Mat& frame, const cv::Mat& silhouette, const cv::Mat& background_edges,
+                         double scale) const;
 
   ShadowOptions options_;
   cv::Mat background_edges_;  // CV_8U 0/255

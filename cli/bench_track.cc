@@ -1,0 +1,58 @@
+#include "cli/bench_track.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+
+#include "common/logging.h"
+#include "tracker/frontend/frontend.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+
+std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, int repeats, int* cameras) {
+  const fs::path dir = fs::temp_directory_path() / ("irbench_bench_track_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup{dir};
+  render.frames = frames;
+  fs::create_directories(dir);
+  render.out = dir / "seq";
+  if (render.background_frames < 2) render.background_frames = 12;
+  Log().info("bench track: rendering {} frame-sets", frames);
+  const fs::path seq = RunRenderJob(render);
+  const SequenceInput input = SequenceInput::Open(seq);
+  *cameras = static_cast<int>(input.cameras().size());
+  const FrontEnd front_end = FrontEnd::Train(input, {});
+  std::vector<std::vector<cv::Mat>> images(input.frame_count());
+  for (int f = 0; f < input.frame_count(); ++f) {
+    for (size_t c = 0; c < input.cameras().size(); ++c) images[f].push_back(input.Frame(static_cast<int>(c), f));
+  }
+  std::vector<double> sil, axes, total;
+  for (int r = 0; r < repeats; ++r) {
+    for (int f = 0; f < input.frame_count(); ++f) {
+      const auto start = std::chrono::steady_clock::now();
+      const FrameFeatures features = front_end.Process(f, images[f]);
+      total.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      sil.push_back(features.ms_silhouettes);
+      axes.push_back(features.ms_axes);
+    }
+  }
+  auto row = [](const std::string& stage, std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    double sum = 0;
+    for (double x : v) sum += x;
+    return TrackBenchRow{stage, v[v.size() / 2], sum / v.size()};
+  };
+  return {row("silhouettes (background model, morphology, shadow removal)", sil),
+          row("2D axis points, body parts, 3D axis points", axes), row("front end, all stages", total)};
+}
+
+}  // namespace irbench
