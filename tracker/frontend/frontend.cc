@@ -12,6 +12,25 @@ void FrontEndOptions::Check() const {
   axes.Check();
 }
 
+cv::Mat ScreenMask(const Camera& camera, const std::vector<ScreenSurface>& screens) {
+  cv::Mat mask = cv::Mat::zeros(camera.height, camera.width, CV_8U);
+  if (screens.empty()) return mask;
+  const Eigen::Vector3d origin = camera.CenterInWorld();
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const auto dir = camera.PixelRayInWorld(Eigen::Vector2d(u, v));
+      if (!dir) continue;
+      for (const ScreenSurface& s : screens) {
+        if (s.Intersect(origin, *dir)) {
+          mask.at<uint8_t>(v, u) = 255;
+          break;
+        }
+      }
+    }
+  }
+  return mask;
+}
+
 FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& options) {
   options.Check();
   if (input.background_count() == 0) {
@@ -23,7 +42,8 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
   fe.cameras_ = input.cameras();
   for (size_t c = 0; c < input.cameras().size(); ++c) {
     const std::vector<cv::Mat> frames = input.Backgrounds(static_cast<int>(c));
-    auto model = BackgroundModel::Train(frames, options.background);
+    auto model = BackgroundModel::Train(frames, options.background,
+                                        ScreenMask(input.cameras()[c], input.screens()));
     auto shadows = ShadowRemover::Train(frames, options.shadow);
     if (!model || !shadows) {
       throw InputError(input.BackgroundPath(static_cast<int>(c), 0).string(), "",

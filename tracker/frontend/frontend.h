@@ -42,6 +42,10 @@ struct FrameFeatures {
   double ms_axes = 0;
 };
 
+// 255 where `camera` sees one of `screens` (from the front), from the
+// calibration and the surveyed screen geometry.
+cv::Mat ScreenMask(const Camera& camera, const std::vector<ScreenSurface>& screens);
+
 class FrontEnd {
  public:
   // Throws InputError when the sequence has no empty-stage frames.

@@ -31,6 +31,51 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std
   return m.reshape(1, rows);
 }
 
+// calib/screens.json (irbench.screens/1): the geometry and the targets'
+// screen coordinates.
+std::vector<ScreenSurface> ReadScreens(const fs::path& path) {
+  const JsonNode root = ParseJsonFile(path.string());
+  if (root.GetString("format") != "irbench.screens/1") root["format"].Fail("expected \"irbench.screens/1\"");
+  std::vector<ScreenSurface> out;
+  const JsonNode list = root["screens"];
+  for (size_t i = 0; i < list.Size(); ++i) {
+    const JsonNode s = list[i];
+    ScreenSurface screen;
+    screen.name = s.GetString("name");
+    const std::string type = s.GetString("type");
+    if (type == "cylinder") {
+      screen.kind = ScreenSurface::Kind::kCylinder;
+      screen.center_xy = s["center_xy"].Vec2();
+      screen.radius = s.GetDouble("radius");
+      screen.angle_left_deg = s.GetDouble("angle_left_deg");
+      screen.angle_right_deg = s.GetDouble("angle_right_deg");
+      const Eigen::Vector2d z = s["z"].Vec2();
+      screen.z0 = z.x(), screen.z1 = z.y();
+      if (!(screen.radius > 0) || screen.z1 <= screen.z0 || screen.angle_left_deg <= screen.angle_right_deg) {
+        s.Fail("not a valid cylinder (radius > 0, z rising, angle_left_deg > angle_right_deg)");
+      }
+    } else if (type == "plane") {
+      screen.kind = ScreenSurface::Kind::kPlane;
+      screen.origin = s["origin"].Vec3();
+      screen.right = s["right"].Vec3().normalized();
+      screen.up = s["up"].Vec3().normalized();
+      screen.width = s.GetDouble("width");
+      screen.height = s.GetDouble("height");
+      if (!(screen.width > 0 && screen.height > 0)) s.Fail("width and height must be positive");
+    } else {
+      s["type"].Fail("must be cylinder or plane");
+    }
+    if (s.Has("targets")) {
+      for (const auto& [name, t] : s["targets"].raw().items()) {
+        const JsonNode target = s["targets"][name];
+        screen.targets[name] = target["screen"].Vec2();
+      }
+    }
+    out.push_back(screen);
+  }
+  return out;
+}
+
 }  // namespace
 
 SequenceInput SequenceInput::Open(const fs::path& dir) {
@@ -83,6 +128,8 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
     if (!found) throw InputError(cameras_file.string(), "cameras", "no camera named '" + name + "'");
     in.cameras_.push_back(cam);
   }
+  const fs::path screens_file = dir / "calib/screens.json";
+  if (fs::is_regular_file(screens_file)) in.screens_ = ReadScreens(screens_file);
   for (size_t c = 0; c < in.cameras_.size(); ++c) {
     const int frames = CountNumbered(dir / "frames" / in.cameras_[c].name);
     const int backgrounds = CountNumbered(dir / "background" / in.cameras_[c].name);

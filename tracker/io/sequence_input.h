@@ -1,7 +1,8 @@
 #pragma once
 // What the tracker reads of a sequence folder: the calibration
 // (calib/intri.yml, calib/extri.yml: OpenCV FileStorage, EasyMocap layout;
-// image sizes and fps from calib/cameras.json), the empty-stage frames
+// image sizes and fps from calib/cameras.json), the screens as a real
+// installation would survey them (calib/screens.json), the empty-stage frames
 // (background/<cam>/) and the frames (frames/<cam>/). Never truth/ and never the
 // manifest (which names the avatar and motion): a real rig has neither.
 
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "sim/camera/camera.h"
+#include "sim/scene/screen.h"
 
 namespace irbench {
 
@@ -25,6 +27,9 @@ class SequenceInput {
   int frame_count() const { return frame_count_; }
   int background_count() const { return background_count_; }
   double fps() const { return cameras_.empty() ? 30.0 : cameras_.front().fps; }
+  // The projection screens as surveyed (calib/screens.json; empty when the
+  // file is absent): geometry and named targets.
+  const std::vector<ScreenSurface>& screens() const { return screens_; }
 
   // 8-bit single-channel images (16-bit frames are scaled to 8 bits). Throws
   // InputError for an unreadable file or one of the wrong size.
@@ -40,6 +45,7 @@ class SequenceInput {
 
   std::filesystem::path dir_;
   std::vector<Camera> cameras_;
+  std::vector<ScreenSurface> screens_;
   int frame_count_ = 0;
   int background_count_ = 0;
 };

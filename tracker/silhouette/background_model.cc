@@ -23,10 +23,11 @@ void BackgroundOptions::Check() const {
 }
 
 std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>& frames,
-                                                      const BackgroundOptions& options) {
+                                                      const BackgroundOptions& options, const cv::Mat& screen) {
   options.Check();
   if (frames.empty()) return std::nullopt;
   const cv::Size size = frames[0].size();
+  if (!screen.empty() && (screen.size() != size || screen.type() != CV_8UC1)) return std::nullopt;
   for (const cv::Mat& f : frames) {
     if (f.size() != size || f.type() != CV_8UC1) return std::nullopt;
   }
@@ -66,6 +67,12 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   const int dof = std::max(1, n - (regress ? 2 : 1));
   cv::Mat sigma;
   cv::sqrt(sq / dof, sigma);
+  mean.convertTo(m.mean_, CV_32F);
+  if (options.model == "flicker" && !screen.empty() && cv::countNonZero(screen) >= 50) {
+    m.screen_ = screen.clone();
+    // Screen pixels follow the projection, not L: they take no part in
+    // estimating L and are modelled by their own gain.
+  }
   a.convertTo(m.a_, CV_32F);
   b.convertTo(m.b_, CV_32F);
   sigma = cv::max(sigma, options.min_sigma);
@@ -84,12 +91,14 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
       }
     }
   }
+  if (!m.screen_.empty()) m.light_pixels_.setTo(0, m.screen_);
   // The pooled difference's noise, measured where it is used.
   if (flicker && options.pool_sigma > 0) {
     double sum_sq = 0;
     size_t count = 0;
     for (int i = 0; i < n; ++i) {
-      cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])));
+      cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
+                               static_cast<float>(m.EstimateScreenGain(frames[i])));
       cv::GaussianBlur(z, z, cv::Size(), m.PoolSigmaPx(size.width));
       sum_sq += z.dot(z);
       count += z.total();
@@ -100,17 +109,40 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   return m;
 }
 
-cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light) const {
+cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float screen_gain) const {
   cv::Mat z(frame.size(), CV_32F);
+  const float screen_sigma_scale = std::max(1.0f, screen_gain);
   for (int y = 0; y < frame.rows; ++y) {
     const uint8_t* ip = frame.ptr<uint8_t>(y);
     const float* ap = a_.ptr<float>(y);
     const float* bp = b_.ptr<float>(y);
     const float* sp = sigma_.ptr<float>(y);
+    const float* mp = mean_.ptr<float>(y);
+    const uint8_t* scr = screen_.empty() ? nullptr : screen_.ptr<uint8_t>(y);
     float* zp = z.ptr<float>(y);
-    for (int x = 0; x < frame.cols; ++x) zp[x] = (ip[x] - (ap[x] + bp[x] * light)) / sp[x];
+    for (int x = 0; x < frame.cols; ++x) {
+      zp[x] = scr && scr[x] ? (ip[x] - screen_gain * mp[x]) / (screen_sigma_scale * sp[x])
+                            : (ip[x] - (ap[x] + bp[x] * light)) / sp[x];
+    }
   }
   return z;
+}
+
+double BackgroundModel::EstimateScreenGain(const cv::Mat& frame) const {
+  if (screen_.empty()) return 1.0;
+  std::vector<float> ratios;
+  for (int y = 0; y < frame.rows; y += 2) {
+    const uint8_t* ip = frame.ptr<uint8_t>(y);
+    const uint8_t* sp = screen_.ptr<uint8_t>(y);
+    const float* mp = mean_.ptr<float>(y);
+    for (int x = 0; x < frame.cols; x += 2) {
+      if (sp[x] && mp[x] > 4) ratios.push_back(ip[x] / mp[x]);
+    }
+  }
+  if (ratios.size() < 20) return 1.0;
+  auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+  std::nth_element(ratios.begin(), mid, ratios.end());
+  return *mid;
 }
 
 cv::Mat BackgroundModel::Expected(double light) const {
@@ -142,7 +174,8 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   CV_Assert(frame.type() == CV_8UC1 && frame.size() == a_.size());
   SilhouetteResult r;
   r.light_level = options_.model == "flicker" ? EstimateLight(frame) : mean_light_;
-  const cv::Mat z = Normalised(frame, static_cast<float>(r.light_level));
+  r.screen_gain = EstimateScreenGain(frame);
+  const cv::Mat z = Normalised(frame, static_cast<float>(r.light_level), static_cast<float>(r.screen_gain));
   r.raw = cv::abs(z) > options_.threshold_sigma;
   {
     cv::Mat smooth;

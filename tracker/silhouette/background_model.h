@@ -50,15 +50,21 @@ struct SilhouetteResult {
   cv::Mat raw;             // before morphology and blob removal
   cv::Mat darker;          // 255 where the frame is darker than the expected stage (smoothed)
   double light_level = 0;  // L(t) (flicker model); the training mean for "plain"
+  double screen_gain = 1;  // the screen pixels' brightness relative to training
   int blobs_removed = 0;
 };
 
 class BackgroundModel {
  public:
   // Learns the model from empty-stage frames (8-bit, one channel, same size).
-  // nullopt when there are none or they differ in size.
+  // `screen` (optional, CV_8U, 255 where the camera sees a projection screen):
+  // those pixels change with the projected content, not with the stage's
+  // light; in the flicker model they get their own gain per frame, the median
+  // of I / μ over the screen pixels (robust to a person covering fewer than
+  // half of them). nullopt when there are no frames or they differ in size.
   static std::optional<BackgroundModel> Train(const std::vector<cv::Mat>& frames,
-                                              const BackgroundOptions& options);
+                                              const BackgroundOptions& options,
+                                              const cv::Mat& screen = cv::Mat());
 
   SilhouetteResult Segment(const cv::Mat& frame) const;
 
@@ -77,11 +83,14 @@ class BackgroundModel {
  private:
   BackgroundOptions options_;
   cv::Mat a_, b_, sigma_;
-  // z = (I − μ(t)) / σ, CV_32F.
-  cv::Mat Normalised(const cv::Mat& frame, float light) const;
+  // z = (I − μ(t)) / σ, CV_32F; screen pixels: (I − g·μ) / (max(g, 1)·σ).
+  cv::Mat Normalised(const cv::Mat& frame, float light, float screen_gain) const;
+  double EstimateScreenGain(const cv::Mat& frame) const;
   double PoolSigmaPx(int width) const { return options_.pool_sigma * width / 320.0; }
 
   cv::Mat light_pixels_;  // CV_8U: pixels whose b is large enough to read L from
+  cv::Mat screen_;        // CV_8U: screen pixels (may be empty)
+  cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;
   double pooled_noise_ = 1;  // std of the pooled z on the training frames
 };

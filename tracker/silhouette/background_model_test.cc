@@ -108,6 +108,31 @@ TEST(BackgroundModelTest, WithoutLightChangeBothModelsAgree) {
   EXPECT_THROW(bad.Check(), std::invalid_argument);
 }
 
+// A projection screen in view whose content brightens by 40% after the
+// empty-stage capture: modelled by its own gain, it stays background.
+TEST(BackgroundModelTest, ScreenPixelsFollowTheirOwnGain) {
+  SyntheticStage stage;
+  cv::Mat screen = cv::Mat::zeros(240, 320, CV_8U);
+  cv::rectangle(screen, cv::Rect(20, 10, 200, 80), 255, cv::FILLED);
+  std::vector<cv::Mat> training;
+  for (int i = 0; i < 10; ++i) training.push_back(stage.Frame(50, 1.5));
+  const auto with_screen = BackgroundModel::Train(training, {}, screen);
+  const auto without = BackgroundModel::Train(training, {});
+  ASSERT_TRUE(with_screen && without);
+  cv::Mat frame = stage.Frame(50, 1.5);
+  cv::Mat brighter;
+  frame.convertTo(brighter, CV_8U, 1.4);
+  brighter.copyTo(frame, screen);
+  cv::Mat person = cv::Mat::zeros(240, 320, CV_8U);
+  cv::rectangle(person, cv::Rect(100, 60, 30, 150), 255, cv::FILLED);  // partly in front of the screen
+  cv::add(frame, 30, frame, person);
+  const SilhouetteResult a = with_screen->Segment(frame), b = without->Segment(frame);
+  EXPECT_NEAR(a.screen_gain, 1.4, 0.03);
+  EXPECT_GT(IoU(a.mask, person), 0.95);
+  EXPECT_LT(IoU(b.mask, person), 0.5);  // the whole screen comes out as foreground
+  EXPECT_FALSE(BackgroundModel::Train(training, {}, cv::Mat::zeros(10, 10, CV_8U)));
+}
+
 TEST(BackgroundModelTest, CleanMaskRemovesSpecksAndSmallBlobs) {
   cv::Mat mask = cv::Mat::zeros(240, 320, CV_8U);
   cv::rectangle(mask, cv::Rect(100, 50, 40, 120), 255, cv::FILLED);   // 4800 px body
