@@ -35,7 +35,7 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
   for (int f = 0; f < input.frame_count(); ++f) {
     for (size_t c = 0; c < input.cameras().size(); ++c) images[f].push_back(input.Frame(static_cast<int>(c), f));
   }
-  std::vector<double> sil, axes, total;
+  std::vector<double> sil, axes, polygons, voxels, polyhedral, total;
   for (int r = 0; r < repeats; ++r) {
     for (int f = 0; f < input.frame_count(); ++f) {
       const auto start = std::chrono::steady_clock::now();
@@ -43,6 +43,9 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
       total.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
       sil.push_back(features.ms_silhouettes);
       axes.push_back(features.ms_axes);
+      polygons.push_back(features.ms_polygons);
+      voxels.push_back(features.ms_voxels);
+      polyhedral.push_back(features.ms_polyhedral);
     }
   }
   auto row = [](const std::string& stage, std::vector<double> v) {
@@ -52,7 +55,9 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
     return TrackBenchRow{stage, v[v.size() / 2], sum / v.size()};
   };
   return {row("silhouettes (background model, morphology, shadow removal)", sil),
-          row("2D axis points, body parts, 3D axis points", axes), row("front end, all stages", total)};
+          row("2D axis points, body parts, 3D axis points", axes), row("silhouette polygons", polygons),
+          row("voxel hull (2 cm, look-up table)", voxels), row("polyhedral hull", polyhedral),
+          row("front end, all stages", total)};
 }
 
 }  // namespace irbench

@@ -10,6 +10,9 @@ void FrontEndOptions::Check() const {
   background.Check();
   shadow.Check();
   axes.Check();
+  polygons.Check();
+  voxels.Check();
+  polyhedral.Check();
 }
 
 cv::Mat ScreenMask(const Camera& camera, const std::vector<ScreenSurface>& screens) {
@@ -52,6 +55,7 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
     fe.background_.push_back(std::move(*model));
     fe.shadows_.push_back(std::move(*shadows));
   }
+  if (options.carve_voxels) fe.carver_ = std::make_shared<VoxelCarver>(input.cameras(), options.voxels);
   return fe;
 }
 
@@ -76,6 +80,24 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
     out.axis3d = ReconstructBodyAxes(cameras_, silhouettes, options_.axes, &out.views);
     out.ms_axes =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - silhouettes_done).count();
+  }
+  auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  std::vector<cv::Mat> silhouettes;
+  for (const CameraFeatures& cf : out.cameras) silhouettes.push_back(cf.silhouette);
+  auto t = std::chrono::steady_clock::now();
+  for (const cv::Mat& s : silhouettes) out.polygons.push_back(ApproximateSilhouette(s, options_.polygons));
+  out.ms_polygons = since(t);
+  if (carver_) {
+    t = std::chrono::steady_clock::now();
+    out.voxels = carver_->Carve(silhouettes);
+    out.ms_voxels = since(t);
+  }
+  if (options_.polyhedral_hull) {
+    t = std::chrono::steady_clock::now();
+    out.hull = PolyhedralVisualHull(cameras_, out.polygons, options_.polyhedral);
+    out.ms_polyhedral = since(t);
   }
   return out;
 }

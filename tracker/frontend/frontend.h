@@ -4,11 +4,16 @@
 // and body parts; across cameras, the 3D axis points. Trained from the
 // sequence's empty-stage frames only.
 
+#include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "tracker/axis/axis3d.h"
+#include "tracker/hull/polygon.h"
+#include "tracker/hull/polyhedral_hull.h"
+#include "tracker/hull/voxel_hull.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/silhouette/background_model.h"
 #include "tracker/silhouette/shadow_removal.h"
@@ -21,6 +26,11 @@ struct FrontEndOptions {
   bool remove_shadows = true;
   BodyAxesOptions axes;  // 2D axis points, body parts, 3D axis points
   bool find_axes = true;
+  PolygonOptions polygons;  // silhouette outlines, 20-30 edges (thesis 3.1, 4.1)
+  VoxelGridOptions voxels;  // voxel hull (thesis 4.2)
+  bool carve_voxels = true;
+  PolyhedralHullOptions polyhedral;  // polyhedral hull (thesis 4.1)
+  bool polyhedral_hull = true;
   void Check() const;  // throws std::invalid_argument
 };
 
@@ -38,8 +48,14 @@ struct FrameFeatures {
   std::vector<AxisView> views;
   // 3D axis points by epipolar intersection (thesis 4.4.2).
   std::vector<AxisPoint3d> axis3d;
+  std::vector<SilhouettePolygons> polygons;  // per camera
+  std::optional<VoxelHull> voxels;
+  std::optional<HullMesh> hull;  // the polyhedral hull (not watertight)
   double ms_silhouettes = 0;  // wall time of each stage for all cameras
   double ms_axes = 0;
+  double ms_polygons = 0;
+  double ms_voxels = 0;
+  double ms_polyhedral = 0;
 };
 
 // 255 where `camera` sees one of `screens` (from the front), from the
@@ -60,6 +76,7 @@ class FrontEnd {
   std::vector<BackgroundModel> background_;
   std::vector<ShadowRemover> shadows_;
   std::vector<Camera> cameras_;
+  std::shared_ptr<const VoxelCarver> carver_;  // its look-up table is built once per rig
 };
 
 }  // namespace irbench

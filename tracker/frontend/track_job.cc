@@ -12,6 +12,7 @@
 #include "common/cancel.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "tracker/hull/ply.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -100,6 +101,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   const fs::path out = options.out.empty() ? options.sequence / "track" : options.out;
   StagingDir staging(out, options.overwrite, "--out");
   const fs::path root = staging.path();
+  if (options.ply) fs::create_directories(root / "hull");
   for (const Camera& cam : input.cameras()) {
     fs::create_directories(root / "silhouettes" / cam.name);
     if (options.overlays) fs::create_directories(root / "overlays" / cam.name);
@@ -135,11 +137,12 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
           if (b != BodyPart::kNone) ++parts[BodyPartName(b)];
         }
       }
-      line["cameras"][name] = {{"silhouette_area", cv::countNonZero(cf.silhouette)},
+      line["cameras"][name]["polygon_edges"] = c < features.polygons.size() ? features.polygons[c].EdgeCount() : 0;
+      line["cameras"][name].update({{"silhouette_area", cv::countNonZero(cf.silhouette)},
                                {"axis", parts},
                                {"shadow_pixels_removed", cv::countNonZero(cf.before_shadows & ~cf.silhouette)},
                                {"light_level", cf.light_level},
-                               {"blobs_removed", cf.blobs_removed}};
+                               {"blobs_removed", cf.blobs_removed}});
       WritePng(root / "silhouettes" / name / FrameName(f), cf.silhouette);
       if (options.overlays) {
         const AxisView* view = c < features.views.size() ? &features.views[c] : nullptr;
@@ -155,7 +158,25 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                         {"support", a.support}});
     }
     line["axis3d"] = axis3d;
-    line["ms"] = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes}};
+    if (features.voxels) {
+      line["voxels"] = {{"occupied", features.voxels->occupied_count},
+                        {"volume_m3", std::round(features.voxels->VolumeM3() * 1e5) / 1e5},
+                        {"voxel_size_m", features.voxels->voxel_size_m}};
+    }
+    line["polyhedral_hull"] =
+        features.hull ? nlohmann::json{{"vertices", features.hull->vertices.size()},
+                                       {"triangles", features.hull->triangles.size()},
+                                       {"volume_m3", std::round(MeshVolume(*features.hull) * 1e5) / 1e5}}
+                      : nlohmann::json(nullptr);
+    line["ms"] = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes},
+                  {"polygons", features.ms_polygons},       {"voxels", features.ms_voxels},
+                  {"polyhedral_hull", features.ms_polyhedral}};
+    if (options.ply) {
+      char stem[32];
+      std::snprintf(stem, sizeof(stem), "%06d", f);
+      if (features.voxels) WriteVoxelCubesPly(root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
+      if (features.hull) WriteMeshPly(root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
+    }
     lines += line.dump() + "\n";
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {

@@ -6,8 +6,12 @@
 //                                  area, the light level, blobs removed; ms per stage
 //   <out>/silhouettes/<cam>/NNNNNN.png   255 person, 0 else
 //   <out>/overlays/<cam>/NNNNNN.png      (--overlays) the frame with the
-//                                  silhouette outline (green) and the pixels
-//                                  shadow removal took away (red)
+//                                  silhouette outline (green), the pixels
+//                                  shadow removal took away (red), axis points
+//                                  by part, 3D axis points projected (white)
+//   <out>/hull/NNNNNN_voxels.ply, NNNNNN_polyhedral.ply   (--ply) the voxel
+//                                  hull as cubes and the polyhedral hull, world
+//                                  metres, z up (MeshLab, Blender)
 //
 // The output folder appears only when complete (StagingDir).
 
@@ -26,6 +30,7 @@ struct TrackJobOptions {
   std::string background_model = "flicker";  // or "plain" (thesis 3.1)
   bool remove_shadows = true;
   bool overlays = false;
+  bool ply = false;  // voxel hull (cubes) and polyhedral hull per frame as PLY
   std::optional<int> frames;  // default: all
   bool overwrite = false;
 };

@@ -1,0 +1,218 @@
+#include "tracker/hull/voxel_hull.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "common/error.h"
+
+namespace irbench {
+
+void VoxelGridOptions::Check() const {
+  if (!(voxel_size_m > 0)) throw InputError("", "voxel_size_m", "must be > 0");
+  for (int a = 0; a < 3; ++a) {
+    if (!(max_corner_m[a] > min_corner_m[a]))
+      throw InputError("", "max_corner_m", "must exceed min_corner_m on every axis");
+  }
+  const Eigen::Vector3d n = (max_corner_m - min_corner_m) / voxel_size_m;
+  if (n.x() * n.y() * n.z() > 4.0e8)
+    throw InputError("", "voxel_size_m", "grid too large (over 4e8 voxels)");
+  if (margin_px < 0 || margin_px > 100) throw InputError("", "margin_px", "must be in [0, 100]");
+  if (footprint_scale < 0 || footprint_scale > 4)
+    throw InputError("", "footprint_scale", "must be in [0, 4]");
+  if (min_observing_cameras < 1) throw InputError("", "min_observing_cameras", "must be >= 1");
+  if (!(near_m > 0)) throw InputError("", "near_m", "must be > 0");
+}
+
+bool VoxelHull::ContainsPoint(const Eigen::Vector3d& p_in_world) const {
+  const Eigen::Vector3d g = (p_in_world - origin_m) / voxel_size_m;
+  const int x = static_cast<int>(std::floor(g.x()));
+  const int y = static_cast<int>(std::floor(g.y()));
+  const int z = static_cast<int>(std::floor(g.z()));
+  if (x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz) return false;
+  return Occupied(x, y, z);
+}
+
+Eigen::Vector3d VoxelHull::VoxelCenter(int x, int y, int z) const {
+  return origin_m + voxel_size_m * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5);
+}
+
+double VoxelHull::VolumeM3() const {
+  return occupied_count * voxel_size_m * voxel_size_m * voxel_size_m;
+}
+
+std::vector<Eigen::Vector3d> VoxelHull::OccupiedCenters() const {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(occupied_count);
+  for (int z = 0; z < nz; ++z) {
+    for (int y = 0; y < ny; ++y) {
+      for (int x = 0; x < nx; ++x) {
+        if (Occupied(x, y, z)) out.push_back(VoxelCenter(x, y, z));
+      }
+    }
+  }
+  return out;
+}
+
+VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& options)
+    : cameras_(std::move(cameras)), options_(options) {
+  options_.Check();
+  if (cameras_.empty()) throw InputError("", "cameras", "no cameras");
+  const double s = options_.voxel_size_m;
+  const Eigen::Vector3d extent = options_.max_corner_m - options_.min_corner_m;
+  nx_ = std::max(1, static_cast<int>(std::ceil(extent.x() / s - 1e-9)));
+  ny_ = std::max(1, static_cast<int>(std::ceil(extent.y() / s - 1e-9)));
+  nz_ = std::max(1, static_cast<int>(std::ceil(extent.z() / s - 1e-9)));
+  const size_t voxels = size_t(nx_) * ny_ * nz_;
+  const int lx = nx_ + 1, ly = ny_ + 1, lz = nz_ + 1;
+  const size_t lattice = size_t(lx) * ly * lz;
+  const size_t nc = cameras_.size();
+  auto centre_of = [&](size_t v) {
+    const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
+              z = static_cast<int>(v / nx_ / ny_);
+    return Eigen::Vector3d(options_.min_corner_m + s * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5));
+  };
+
+  // Pass 1: which voxels enough cameras observe (centre in front and in the image).
+  std::vector<uint8_t> observed(voxels, 0);
+  for (size_t c = 0; c < nc; ++c) {
+    const Camera& cam = cameras_[c];
+    if (cam.width <= 1 || cam.height <= 1 || cam.width > 32767 || cam.height > 32767) {
+      throw InputError("", "cameras[" + std::to_string(c) + "].width", "bad image size");
+    }
+    for (size_t v = 0; v < voxels; ++v) {
+      const Eigen::Vector3d centre = centre_of(v);
+      if ((cam.cam_from_world * centre).z() <= options_.near_m) continue;
+      const Eigen::Vector2d pc = cam.Project(centre);
+      if (pc.x() >= -0.5 && pc.y() >= -0.5 && pc.x() <= cam.width - 0.5 &&
+          pc.y() <= cam.height - 0.5)
+        ++observed[v];
+    }
+  }
+  for (size_t v = 0; v < voxels; ++v) {
+    if (observed[v] >= options_.min_observing_cameras)
+      candidates_.push_back(static_cast<uint32_t>(v));
+  }
+  observed = {};
+
+  // Pass 2, per camera: the footprint of every candidate, from the projected
+  // lattice corners (each shared by up to 8 voxels).
+  const size_t nk = candidates_.size();
+  footprints_.assign(nk * nc, Footprint{-1, 0, 0, 0});
+  std::vector<float> lu(lattice), lv(lattice);
+  std::vector<uint8_t> lok(lattice);
+  const double m = options_.margin_px;
+  for (size_t c = 0; c < nc; ++c) {
+    const Camera& cam = cameras_[c];
+    for (int z = 0; z < lz; ++z) {
+      for (int y = 0; y < ly; ++y) {
+        for (int x = 0; x < lx; ++x) {
+          const size_t i = (size_t(z) * ly + y) * lx + x;
+          const Eigen::Vector3d p = options_.min_corner_m + s * Eigen::Vector3d(x, y, z);
+          lok[i] = (cam.cam_from_world * p).z() > options_.near_m;
+          if (lok[i]) {
+            const Eigen::Vector2d px = cam.Project(p);
+            lu[i] = static_cast<float>(px.x());
+            lv[i] = static_cast<float>(px.y());
+          }
+        }
+      }
+    }
+    const int w = cam.width, h = cam.height;
+    Footprint* out = footprints_.data() + c * nk;
+    for (size_t k = 0; k < nk; ++k) {
+      const size_t v = candidates_[k];
+      const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
+                z = static_cast<int>(v / nx_ / ny_);
+      size_t corner_index[8];
+      bool ok = true;
+      for (int corner = 0; corner < 8; ++corner) {
+        corner_index[corner] =
+            (size_t(z + (corner >> 2)) * ly + y + ((corner >> 1) & 1)) * lx + x + (corner & 1);
+        ok = ok && lok[corner_index[corner]];
+      }
+      if (!ok) continue;  // partly behind the camera: no constraint
+      const Eigen::Vector2d pc = cam.Project(centre_of(v));
+      double corner_radius = 0;
+      for (size_t i : corner_index)
+        corner_radius = std::max(corner_radius, std::hypot(lu[i] - pc.x(), lv[i] - pc.y()));
+      const double radius = options_.footprint_scale * corner_radius + m;
+      // The disk partly outside the image: the camera cannot rule the voxel out.
+      if (pc.x() - radius < -0.5 || pc.y() - radius < -0.5 || pc.x() + radius > w - 0.5 ||
+          pc.y() + radius > h - 0.5) {
+        continue;
+      }
+      // Bilinear interpolation reads the pixel right of and below the floor.
+      const double fu = std::clamp(pc.x(), 0.0, w - 1.001), fv = std::clamp(pc.y(), 0.0, h - 1.001);
+      const int u0 = static_cast<int>(fu), v0 = static_cast<int>(fv);
+      out[k].pixel = v0 * w + u0;
+      out[k].frac_u = static_cast<uint8_t>(std::min(255.0, std::round((fu - u0) * 256)));
+      out[k].frac_v = static_cast<uint8_t>(std::min(255.0, std::round((fv - v0) * 256)));
+      out[k].radius_q = static_cast<uint16_t>(std::min(65535.0, std::floor(radius * 64)));
+    }
+  }
+}
+
+VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
+  const size_t nc = cameras_.size();
+  if (silhouettes.size() != nc) {
+    throw InputError("", "silhouettes",
+                     "expected " + std::to_string(nc) + " silhouettes, got " +
+                         std::to_string(silhouettes.size()));
+  }
+  VoxelHull hull;
+  hull.origin_m = options_.min_corner_m;
+  hull.voxel_size_m = options_.voxel_size_m;
+  hull.nx = nx_;
+  hull.ny = ny_;
+  hull.nz = nz_;
+  hull.occupied.assign(size_t(nx_) * ny_ * nz_, 0);
+
+  // Camera by camera: the first streams through all candidates' footprints,
+  // later ones only through the survivors.
+  const size_t nk = candidates_.size();
+  std::vector<uint32_t> alive;
+  cv::Mat background, distance;
+  for (size_t c = 0; c < nc; ++c) {
+    const cv::Mat& sil = silhouettes[c];
+    if (sil.type() != CV_8UC1 || sil.cols != cameras_[c].width || sil.rows != cameras_[c].height) {
+      throw InputError("", "silhouettes[" + std::to_string(c) + "]",
+                       "must be CV_8UC1 of the camera's size");
+    }
+    // Distance from each pixel centre to the nearest silhouette pixel centre
+    // (exact Euclidean), pixels.
+    cv::threshold(sil, background, 127, 255, cv::THRESH_BINARY_INV);
+    if (cv::countNonZero(background) == static_cast<int>(background.total())) {
+      distance = cv::Mat(sil.size(), CV_32F, cv::Scalar(1e6));  // no silhouette: all far
+    } else {
+      cv::distanceTransform(background, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+    }
+    const float* dist = distance.ptr<float>();
+    const int w = sil.cols;
+    const Footprint* fp = footprints_.data() + c * nk;
+    auto keep = [&](uint32_t k) {
+      const Footprint& f = fp[k];
+      if (f.pixel < 0) return true;
+      const float* d = dist + f.pixel;
+      const float fu = f.frac_u * (1.0f / 256), fv = f.frac_v * (1.0f / 256);
+      const float top = d[0] + fu * (d[1] - d[0]);
+      const float bottom = d[w] + fu * (d[w + 1] - d[w]);
+      return top + fv * (bottom - top) <= f.radius_q * (1.0f / 64);
+    };
+    if (c == 0) {
+      for (uint32_t k = 0; k < nk; ++k) {
+        if (keep(k)) alive.push_back(k);
+      }
+    } else {
+      alive.erase(std::remove_if(alive.begin(), alive.end(), [&](uint32_t k) { return !keep(k); }),
+                  alive.end());
+    }
+  }
+  for (uint32_t k : alive) hull.occupied[candidates_[k]] = 1;
+  hull.occupied_count = static_cast<int>(alive.size());
+  return hull;
+}
+
+}  // namespace irbench

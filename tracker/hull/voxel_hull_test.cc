@@ -1,0 +1,217 @@
+#include "tracker/hull/voxel_hull.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "common/error.h"
+#include "tracker/hull/hull_test_util.h"
+
+namespace irbench {
+namespace {
+using irbench::testing::BoxSilhouette;
+using irbench::testing::HullRig;
+using irbench::testing::SphereSilhouette;
+
+const Eigen::Vector3d kCentre(0.2, -0.1, 1.0);
+constexpr double kRadius = 0.3;
+
+// Points of the solid, sampled on a jittered grid at voxel spacing, that do not
+// lie in an occupied voxel; `checked` counts the samples.
+template <typename Inside>
+int Missed(const VoxelHull& hull,
+           const Eigen::Vector3d& lo,
+           const Eigen::Vector3d& hi,
+           Inside inside,
+           int* checked_out = nullptr) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(0, 1);
+  const double step = hull.voxel_size_m;
+  int checked = 0, missed = 0;
+  for (double x = lo.x(); x <= hi.x(); x += step) {
+    for (double y = lo.y(); y <= hi.y(); y += step) {
+      for (double z = lo.z(); z <= hi.z(); z += step) {
+        const Eigen::Vector3d p = Eigen::Vector3d(x, y, z) +
+                                  step * Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+        if (!inside(p)) continue;
+        ++checked;
+        if (!hull.ContainsPoint(p)) ++missed;
+      }
+    }
+  }
+  if (checked_out) *checked_out = checked;
+  return missed;
+}
+
+// Silhouettes rasterised at pixel centres lie up to 1/sqrt(2) px inside the
+// true outline, so containing every point of the solid takes that margin.
+VoxelGridOptions Strict() {
+  VoxelGridOptions options;
+  options.margin_px = 0.75;
+  return options;
+}
+
+std::vector<cv::Mat> Spheres(const std::vector<Camera>& cams) {
+  std::vector<cv::Mat> out;
+  for (const Camera& cam : cams) out.push_back(SphereSilhouette(cam, kCentre, kRadius));
+  return out;
+}
+
+TEST(VoxelHullTest, ContainsTheSphereWithBoundedVolume) {
+  auto in_sphere = [](const Eigen::Vector3d& p) { return (p - kCentre).norm() < kRadius; };
+  const Eigen::Vector3d lo = kCentre.array() - kRadius, hi = kCentre.array() + kRadius;
+  const double sphere = 4.0 / 3.0 * M_PI * std::pow(kRadius, 3);
+  for (int ring : {4, 6}) {
+    const std::vector<Camera> cams = HullRig(ring, 2);
+    const VoxelHull hull = VoxelCarver(cams, Strict()).Carve(Spheres(cams));
+    int checked = 0;
+    EXPECT_EQ(Missed(hull, lo, hi, in_sphere, &checked), 0);
+    EXPECT_GT(checked, 5000);
+    const double ratio = hull.VolumeM3() / sphere;
+    EXPECT_GT(ratio, 1.0);
+    // The exact visual hull of a sphere from 6-8 spread views is within ~15%
+    // of the sphere; the test disk (projected voxel radius, 2.2 cm, plus
+    // 0.75 px, 1 cm) adds a shell of at most about 3 cm: a factor
+    // (0.33 / 0.3)^3 = 1.33.
+    EXPECT_LT(ratio, 1.15 * 1.33);
+    // No occupied voxel is far from the sphere (the cones meet near it).
+    for (const Eigen::Vector3d& c : hull.OccupiedCenters())
+      EXPECT_LT((c - kCentre).norm(), kRadius + 0.1);
+    // The default (margin 0) loses at most a sliver at the outline.
+    const VoxelHull tight = VoxelCarver(cams).Carve(Spheres(cams));
+    const int missed = Missed(tight, lo, hi, in_sphere);
+    EXPECT_LE(missed, checked / 500);
+    EXPECT_LT(tight.occupied_count, hull.occupied_count);
+    std::printf(
+        "sphere, %d cameras: volume ratio %.3f (margin 0.75 px), %.3f with %.2f%% contained "
+        "(margin 0)\n",
+        ring + 2, ratio, tight.VolumeM3() / sphere, 100.0 - 100.0 * missed / checked);
+  }
+}
+
+TEST(VoxelHullTest, ContainsTheBox) {
+  const Eigen::Vector3d lo(-0.35, -0.2, 0.4), hi(0.25, 0.3, 1.6);
+  const std::vector<Camera> cams = HullRig(4, 1);
+  VoxelGridOptions options = Strict();
+  options.voxel_size_m = 0.03;
+  const VoxelCarver carver(cams, options);
+  std::vector<cv::Mat> sil;
+  for (const Camera& cam : cams) sil.push_back(BoxSilhouette(cam, lo, hi));
+  const VoxelHull hull = carver.Carve(sil);
+  EXPECT_EQ(Missed(hull, lo, hi,
+                   [&](const Eigen::Vector3d& p) {
+                     return (p.array() > lo.array()).all() && (p.array() < hi.array()).all();
+                   }),
+            0);
+  const double ratio = hull.VolumeM3() / (hi - lo).prod();
+  std::printf("box, 5 cameras: volume ratio %.3f\n", ratio);
+  EXPECT_GT(ratio, 1.0);
+  EXPECT_LT(ratio, 2.0);
+}
+
+// The look-up table and the interpolated distance transforms give the same
+// answer as measuring, per voxel, the distance from its projected centre to
+// every silhouette pixel centre: identical except within the interpolation
+// error of the distance field (about half a pixel) of the threshold.
+TEST(VoxelHullTest, MatchesABruteForceCarving) {
+  const std::vector<Camera> cams = HullRig(4, 0);
+  VoxelGridOptions options;
+  options.voxel_size_m = 0.05;
+  options.min_observing_cameras = 1;
+  options.margin_px = 0.3;
+  const VoxelCarver carver(cams, options);
+  const std::vector<cv::Mat> sil = Spheres(cams);
+  const VoxelHull hull = carver.Carve(sil);
+  std::vector<std::vector<Eigen::Vector2d>> pixels(cams.size());
+  for (size_t c = 0; c < cams.size(); ++c) {
+    for (int v = 0; v < 240; ++v) {
+      for (int u = 0; u < 320; ++u) {
+        if (sil[c].at<uint8_t>(v, u)) pixels[c].emplace_back(u, v);
+      }
+    }
+  }
+  int agree = 0, borderline = 0;
+  for (int z = 0; z < hull.nz; ++z) {
+    for (int y = 0; y < hull.ny; ++y) {
+      for (int x = 0; x < hull.nx; ++x) {
+        const Eigen::Vector3d centre = hull.VoxelCenter(x, y, z);
+        if ((centre - kCentre).norm() > 0.6) {
+          EXPECT_FALSE(hull.Occupied(x, y, z));  // every camera sees it, far off the sphere
+          continue;
+        }
+        bool keep = true, unsure = false;
+        for (size_t c = 0; c < cams.size(); ++c) {
+          const Eigen::Vector2d pc = cams[c].Project(centre);
+          double radius = 0;
+          for (int k = 0; k < 8; ++k) {
+            const Eigen::Vector3d corner =
+                hull.origin_m +
+                hull.voxel_size_m * Eigen::Vector3d(x + (k & 1), y + ((k >> 1) & 1), z + (k >> 2));
+            radius = std::max(radius, (cams[c].Project(corner) - pc).norm());
+          }
+          radius += options.margin_px;
+          double nearest = 1e9;
+          for (const Eigen::Vector2d& p : pixels[c]) nearest = std::min(nearest, (p - pc).norm());
+          if (std::abs(nearest - radius) < 0.6) unsure = true;
+          if (nearest > radius) keep = false;
+        }
+        if (unsure) {
+          ++borderline;
+          continue;
+        }
+        EXPECT_EQ(hull.Occupied(x, y, z), keep) << x << " " << y << " " << z;
+        agree += keep;
+      }
+    }
+  }
+  EXPECT_GT(agree, 100);
+  EXPECT_LT(borderline, agree);
+}
+
+TEST(VoxelHullTest, CamerasThatDoNotSeeAVoxelDoNotCarveIt) {
+  std::vector<Camera> cams = HullRig(4, 0);
+  const VoxelCarver base(cams);
+  const VoxelHull reference = base.Carve(Spheres(cams));
+  EXPECT_GT(reference.occupied_count, 1000);
+  // A camera behind the stage looking away, with an empty silhouette.
+  Camera away = cams[0];
+  away.cam_from_world = *LookAt({0, -4, 1.5}, {0, -8, 1.5}, Eigen::Vector3d::UnitZ());
+  cams.push_back(away);
+  std::vector<cv::Mat> sil = Spheres(cams);
+  EXPECT_EQ(cv::countNonZero(sil.back()), 0);
+  const VoxelHull hull = VoxelCarver(cams).Carve(sil);
+  EXPECT_EQ(hull.occupied, reference.occupied);
+  // An empty silhouette in a camera that sees the sphere carves everything.
+  sil = Spheres(cams);
+  sil[1].setTo(0);
+  EXPECT_EQ(VoxelCarver(cams).Carve(sil).occupied_count, 0);
+}
+
+TEST(VoxelHullTest, RejectsBadInput) {
+  VoxelGridOptions bad;
+  bad.voxel_size_m = 0;
+  EXPECT_THROW(bad.Check(), InputError);
+  bad = {};
+  bad.max_corner_m.z() = -1;
+  EXPECT_THROW(bad.Check(), InputError);
+  bad = {};
+  bad.footprint_scale = -1;
+  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_THROW(VoxelCarver({}, {}), InputError);
+  const std::vector<Camera> cams = HullRig(2, 0);
+  VoxelGridOptions coarse;
+  coarse.voxel_size_m = 0.1;
+  const VoxelCarver carver(cams, coarse);
+  EXPECT_THROW(carver.Carve({cv::Mat::zeros(240, 320, CV_8UC1)}), InputError);
+  EXPECT_THROW(carver.Carve({cv::Mat::zeros(240, 320, CV_8UC1), cv::Mat::zeros(100, 320, CV_8UC1)}),
+               InputError);
+  const VoxelHull hull =
+      carver.Carve({cv::Mat::zeros(240, 320, CV_8UC1), cv::Mat::zeros(240, 320, CV_8UC1)});
+  EXPECT_EQ(hull.occupied_count, 0);
+  EXPECT_FALSE(hull.ContainsPoint({5, 5, 5}));
+  EXPECT_EQ(hull.nx, 30);
+  EXPECT_EQ(hull.nz, 22);
+}
+
+}  // namespace
+}  // namespace irbench
