@@ -103,6 +103,9 @@ int main(int argc, char** argv) {
   track_cmd->add_flag("--keep-shadows", track_keep_shadows, "skip the edge-based shadow removal");
   track_cmd->add_flag("--overlays", track.overlays, "also write debug overlays (PNG, colour)");
   track_cmd->add_flag("--ply", track.ply, "also write the voxel and polyhedral hulls per frame as PLY");
+  track_cmd->add_option("--hull-missing-views", track.hull_missing_views,
+                        "voxel hull: cameras allowed to disagree (0: the thesis's hull; 1 keeps what one view lost)")
+      ->capture_default_str();
   track_cmd->add_option("--frames", track_frames, "frames to process (default: all)");
   track_cmd->add_option("--out", track_out, "output folder (default: SEQ/track)");
   track_cmd->add_flag("--force", track.overwrite, "replace an existing output folder");

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -13,6 +14,7 @@
 
 #include "sim/sequence/render_job.h"
 #include "tests/test_util.h"
+#include "tests/true_body.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/silhouette/background_model.h"
@@ -184,6 +186,76 @@ TEST(FrontendClosedLoopTest, ArmAxisFromThesisSilhouettes) {
               "median %.1f mm, p90 %.1f mm\n",
               distances.size(), 1000 * median, 1000 * p90);
   EXPECT_LE(median, 0.04);
+}
+
+// The voxel hull carved from the front end's own silhouettes (thesis preset),
+// against the true body: how much of it the hull holds and how large it is.
+TEST(FrontendClosedLoopTest, VoxelHullFromThesisSilhouettes) {
+  const fs::path dir = FreshTempDir("frontend_hull");
+  std::vector<double> containment, ratio, containment_tolerant, ratio_tolerant;
+  std::mt19937 rng(5);
+  for (const std::string person : {"p1", "p3", "p4"}) {
+    RenderJobOptions options;
+    options.rig = "theater4";
+    options.avatar = person;
+    options.motion = (dir / "tour.json").string();
+    WriteText(dir / "tour.json", R"({"format": "irbench.session/1", "items": [{"motion": "atom_tour", "speed": 6}]})");
+    options.sensor = "thesis";
+    options.frames = 3;
+    options.background_frames = 12;
+    options.seed = 9;
+    options.out = dir / person;
+    const fs::path seq = RunRenderJob(options);
+    const RenderInputs truth_inputs = LoadRenderInputs(options);
+    const SequenceInput in = SequenceInput::Open(seq);
+    FrontEndOptions fe_options;
+    fe_options.find_axes = false;
+    fe_options.polyhedral_hull = false;
+    const FrontEnd front_end = FrontEnd::Train(in, fe_options);
+    VoxelGridOptions tolerant_options;
+    tolerant_options.max_missing_views = 1;
+    const VoxelCarver tolerant(in.cameras(), tolerant_options);
+    for (int f = 0; f < in.frame_count(); ++f) {
+      std::vector<cv::Mat> images;
+      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const FrameFeatures features = front_end.Process(f, images);
+      ASSERT_TRUE(features.voxels);
+      const irbench::testing::BodyMesh body = irbench::testing::PosedBody(truth_inputs, f);
+      std::uniform_real_distribution<double> ux(body.lo.x(), body.hi.x()), uy(body.lo.y(), body.hi.y()),
+          uz(body.lo.z(), body.hi.z());
+      std::vector<cv::Mat> silhouettes;
+      for (const CameraFeatures& cf : features.cameras) silhouettes.push_back(cf.silhouette);
+      const VoxelHull tolerant_hull = tolerant.Carve(silhouettes);
+      int inside = 0, held = 0, held_tolerant = 0;
+      while (inside < 2000) {
+        const Eigen::Vector3d p(ux(rng), uy(rng), uz(rng));
+        if (!irbench::testing::Inside(body, p)) continue;
+        ++inside;
+        held += features.voxels->ContainsPoint(p);
+        held_tolerant += tolerant_hull.ContainsPoint(p);
+      }
+      const double volume = irbench::testing::Volume(body);
+      containment.push_back(double(held) / inside);
+      ratio.push_back(features.voxels->VolumeM3() / volume);
+      containment_tolerant.push_back(double(held_tolerant) / inside);
+      ratio_tolerant.push_back(tolerant_hull.VolumeM3() / volume);
+      std::printf("%s frame %d: voxel hull holds %.1f%% of the body, volume %.2fx; one view may miss: %.1f%%, %.2fx\n",
+                  person.c_str(), f, 100 * containment.back(), ratio.back(), 100 * containment_tolerant.back(),
+                  ratio_tolerant.back());
+    }
+    fs::remove_all(seq);
+  }
+  std::printf("voxel hull from thesis-preset silhouettes: containment median %.1f%%, volume ratio median %.2f; "
+              "one view may miss: %.1f%%, %.2f\n",
+              100 * Median(containment), Median(ratio), 100 * Median(containment_tolerant), Median(ratio_tolerant));
+  // Floors under today's figures (79.3%, 1.35x; tolerant 93.8%, 2.95x). The
+  // issue's bars (98%, at most 2x) are met on the truth masks
+  // (tracker/hull/hull_closed_loop_test.cc), not yet on the tracker's own
+  // silhouettes: a body part one camera loses is carved away.
+  EXPECT_GE(Median(containment), 0.72);
+  EXPECT_LE(Median(ratio), 2.0);
+  EXPECT_GE(Median(containment_tolerant), 0.9);
+  EXPECT_GT(Median(containment_tolerant), Median(containment));
 }
 
 }  // namespace

@@ -88,10 +88,15 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   fe_options.background.model = options.background_model;
   fe_options.remove_shadows = options.remove_shadows;
   try {
-    fe_options.Check();
+    fe_options.background.Check();
   } catch (const std::invalid_argument& e) {
     throw InputError("", "--background-model", e.what());
   }
+  if (options.hull_missing_views < 0 || options.hull_missing_views > 2) {
+    throw InputError("", "--hull-missing-views", "must be 0, 1 or 2");
+  }
+  fe_options.voxels.max_missing_views = options.hull_missing_views;
+  fe_options.Check();
   const SequenceInput input = SequenceInput::Open(options.sequence);
   int frames = input.frame_count();
   if (options.frames) {
@@ -190,6 +195,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                          {"stage", options.stage},
                          {"background_model", options.background_model},
                          {"remove_shadows", options.remove_shadows},
+                         {"hull_missing_views", options.hull_missing_views},
                          {"frames", frames},
                          {"train_ms", train_ms}};
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");

@@ -30,7 +30,8 @@ struct TrackJobOptions {
   std::string background_model = "flicker";  // or "plain" (thesis 3.1)
   bool remove_shadows = true;
   bool overlays = false;
-  bool ply = false;  // voxel hull (cubes) and polyhedral hull per frame as PLY
+  bool ply = false;
+  int hull_missing_views = 0;  // voxel hull: views allowed to disagree (0: the thesis's hull)  // voxel hull (cubes) and polyhedral hull per frame as PLY
   std::optional<int> frames;  // default: all
   bool overwrite = false;
 };

@@ -12,6 +12,7 @@ namespace irbench {
 
 void VoxelGridOptions::Check() const {
   if (!(voxel_size_m > 0)) throw InputError("", "voxel_size_m", "must be > 0");
+  if (max_missing_views < 0 || max_missing_views > 8) throw InputError("", "max_missing_views", "must be in 0..8");
   for (int a = 0; a < 3; ++a) {
     if (!(max_corner_m[a] > min_corner_m[a]))
       throw InputError("", "max_corner_m", "must exceed min_corner_m on every axis");
@@ -174,6 +175,7 @@ VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
   // later ones only through the survivors.
   const size_t nk = candidates_.size();
   std::vector<uint32_t> alive;
+  std::vector<uint8_t> misses;
   cv::Mat background, distance;
   for (size_t c = 0; c < nc; ++c) {
     const cv::Mat& sil = silhouettes[c];
@@ -201,7 +203,19 @@ VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
       const float bottom = d[w] + fu * (d[w + 1] - d[w]);
       return top + fv * (bottom - top) <= f.radius_q * (1.0f / 64);
     };
-    if (c == 0) {
+    const int allowed = options_.max_missing_views;
+    if (allowed > 0) {
+      // Tolerant carving: a voxel goes only when more than `allowed` views
+      // put it outside their silhouettes.
+      if (c == 0) {
+        misses.assign(nk, 0);
+        alive.resize(nk);
+        for (uint32_t k = 0; k < nk; ++k) alive[k] = k;
+      }
+      alive.erase(std::remove_if(alive.begin(), alive.end(),
+                                 [&](uint32_t k) { return !keep(k) && ++misses[k] > allowed; }),
+                  alive.end());
+    } else if (c == 0) {
       for (uint32_t k = 0; k < nk; ++k) {
         if (keep(k)) alive.push_back(k);
       }

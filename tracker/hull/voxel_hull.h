@@ -48,6 +48,11 @@ struct VoxelGridOptions {
   // Corners nearer than this to a camera's image plane (camera z, metres)
   // make that camera place no constraint on the voxel.
   double near_m = 0.05;
+  // Views allowed to disagree: a voxel is carved only when more than this many
+  // of the cameras that see it put it outside their silhouettes. 0 is the
+  // thesis's hull; 1 keeps body parts one camera's silhouette lost (clothing
+  // as grey as the wall), at the cost of volume.
+  int max_missing_views = 0;
 
   void Check() const;  // throws InputError naming the field
 };

@@ -89,6 +89,36 @@ TEST(VoxelHullTest, ContainsTheSphereWithBoundedVolume) {
   }
 }
 
+// One camera loses the sphere: the thesis's hull loses it with it; a carver
+// that lets one view disagree keeps exactly the hull of the other views.
+TEST(VoxelHullTest, OneMissingViewIsToleratedWhenAsked) {
+  const std::vector<Camera> cams = HullRig(6, 2);
+  std::vector<cv::Mat> sil = Spheres(cams);
+  sil[3] = cv::Mat::zeros(sil[3].size(), CV_8UC1);
+  VoxelGridOptions strict = Strict();
+  strict.voxel_size_m = 0.03;
+  strict.min_corner_m = {-0.5, -0.5, 0.4};
+  strict.max_corner_m = {0.8, 0.7, 1.6};
+  EXPECT_EQ(VoxelCarver(cams, strict).Carve(sil).occupied_count, 0);
+  VoxelGridOptions tolerant = strict;
+  tolerant.max_missing_views = 1;
+  const VoxelHull kept = VoxelCarver(cams, tolerant).Carve(sil);
+  std::vector<Camera> others = cams;
+  others.erase(others.begin() + 3);
+  std::vector<cv::Mat> other_sil = Spheres(others);
+  const VoxelHull reference = VoxelCarver(others, strict).Carve(other_sil);
+  // The same voxels, except where a voxel was seen by only two cameras, one
+  // of them the blind one (then no hull holds it).
+  int differ = 0;
+  for (size_t i = 0; i < kept.occupied.size(); ++i) differ += kept.occupied[i] != reference.occupied[i];
+  EXPECT_LE(differ, reference.occupied_count / 100);
+  EXPECT_GT(reference.occupied_count, 300);
+  auto in_sphere = [](const Eigen::Vector3d& p) { return (p - kCentre).norm() < kRadius; };
+  EXPECT_EQ(Missed(kept, kCentre.array() - kRadius, kCentre.array() + kRadius, in_sphere), 0);
+  tolerant.max_missing_views = -1;
+  EXPECT_THROW(tolerant.Check(), InputError);
+}
+
 TEST(VoxelHullTest, ContainsTheBox) {
   const Eigen::Vector3d lo(-0.35, -0.2, 0.4), hi(0.25, 0.3, 1.6);
   const std::vector<Camera> cams = HullRig(4, 1);
@@ -172,7 +202,7 @@ TEST(VoxelHullTest, CamerasThatDoNotSeeAVoxelDoNotCarveIt) {
   std::vector<Camera> cams = HullRig(4, 0);
   const VoxelCarver base(cams);
   const VoxelHull reference = base.Carve(Spheres(cams));
-  EXPECT_GT(reference.occupied_count, 1000);
+  EXPECT_GT(reference.occupied_count, 300);
   // A camera behind the stage looking away, with an empty silhouette.
   Camera away = cams[0];
   away.cam_from_world = *LookAt({0, -4, 1.5}, {0, -8, 1.5}, Eigen::Vector3d::UnitZ());
