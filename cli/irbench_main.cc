@@ -14,6 +14,7 @@
 #include "sim/sequence/motion_tools.h"
 #include "sim/sequence/render_bench.h"
 #include "sim/sequence/render_job.h"
+#include "ci/score/score.h"
 #include "tracker/frontend/track_job.h"
 
 namespace {
@@ -59,7 +60,7 @@ irbench::GlBackend BackendOrThrow(const std::string& name) {
 int main(int argc, char** argv) {
   CLI::App app{"irbench: a test bench for multi-camera near-infrared body tracking.\n"
                "Renders calibrated multi-camera sequences with exact truth (render),\n"
-               "runs the tracker on them (track); more arrives with the tracker and the harness.",
+               "runs the tracker on them (track) and scores track files against the truth (score).",
                "irbench"};
   app.require_subcommand(1);
   app.set_version_flag("--version", irbench::ToolVersion());
@@ -109,6 +110,19 @@ int main(int argc, char** argv) {
   track_cmd->add_option("--frames", track_frames, "frames to process (default: all)");
   track_cmd->add_option("--out", track_out, "output folder (default: SEQ/track)");
   track_cmd->add_flag("--force", track.overwrite, "replace an existing output folder");
+
+  // score
+  irbench::ScoreJobOptions score;
+  std::string score_sequence, score_track, score_out;
+  CLI::App* score_cmd = app.add_subcommand(
+      "score", "Score a track file against the sequence's truth: the thesis's tables (joint errors with\n"
+               "Chauvenet outliers, pointing angles, rest state, motion labels) as JSON, Markdown and CSV");
+  score_cmd->add_option("SEQ", score_sequence, "sequence folder written by render")->required();
+  score_cmd->add_option("--track", score_track, "track.jsonl to score (default: SEQ/track/track.jsonl)");
+  score_cmd->add_option("--out", score_out, "output folder (default: SEQ/score)");
+  score_cmd->add_flag("--include-rest-arms", score.score.include_rest_arms,
+                      "also score elbows and wrists of arms at rest (the thesis leaves them out)");
+  score_cmd->add_flag("--force", score.overwrite, "replace an existing output folder");
 
   // motion
   CLI::App* motion_cmd = app.add_subcommand("motion", "List, inspect and export motions");
@@ -201,6 +215,15 @@ int main(int argc, char** argv) {
       track.remove_shadows = !track_keep_shadows;
       if (track_cmd->count("--frames") > 0) track.frames = track_frames;
       std::cout << irbench::RunTrackJob(track).string() << "\n";
+      return kExitOk;
+    }
+    if (score_cmd->parsed()) {
+      score.sequence = score_sequence;
+      score.track = score_track;
+      score.out = score_out;
+      std::string tables;
+      const std::filesystem::path folder = irbench::RunScoreJob(score, &tables);
+      std::cout << tables << "\n" << folder.string() << "\n";
       return kExitOk;
     }
     if (avatar_list->parsed()) {

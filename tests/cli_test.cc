@@ -60,7 +60,7 @@ TEST(CliTest, HelpOnEveryCommand) {
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
         {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
         {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
-        {"track", "--help"}, {"bench", "track", "--help"}}) {
+        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
@@ -308,6 +308,44 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
   }
   for (const char* name : {"t2", "t3"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
+}
+
+TEST(CliTest, ScorePrintsTheTablesAndRefusesBadInput) {
+  const fs::path dir = FreshTempDir("cli_score");
+  ASSERT_EQ(RunIrbench({"render", "--rig", "lab4", "--frames", "6", "--background-frames", "0", "--supersample",
+                        "1", "--out", (dir / "seq").string()},
+                       dir)
+                .exit_code,
+            0);
+  // A track that is the truth with the root 5 cm off.
+  std::ifstream truth(dir / "seq/truth/frames.jsonl");
+  std::string track;
+  for (std::string line; std::getline(truth, line);) {
+    auto t = nlohmann::json::parse(line);
+    t["joints3d"]["root"][1] = t["joints3d"]["root"][1].get<double>() + 0.05;
+    track += nlohmann::json{{"frame", t["frame"]}, {"state", "tracking"}, {"joints3d", t["joints3d"]}}.dump() + "\n";
+  }
+  WriteText(dir / "track.jsonl", track);
+  const Result r = RunIrbench({"score", (dir / "seq").string(), "--track", (dir / "track.jsonl").string()}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| Root | 5.00 | 0.00 | 0 | 6 | 0 |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| Waist | 0.00 |"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "seq/score/score.json"));
+  EXPECT_TRUE(fs::exists(dir / "seq/score/errors.csv"));
+  WriteText(dir / "bad.jsonl", "{\"frame\": 0, \"joints3d\": {\"root\": \"here\"}}\n");
+  for (const auto& [args, expected] :
+       {std::pair<std::vector<std::string>, std::string>{{"score", (dir / "seq").string(), "--track",
+                                                         (dir / "bad.jsonl").string(), "--out",
+                                                         (dir / "s2").string()},
+                                                        "bad.jsonl: line 1: root"},
+        {{"score", (dir / "seq").string(), "--out", (dir / "s3").string()}, "no such track file"},
+        {{"score", (dir / "missing").string(), "--track", (dir / "track.jsonl").string()}, "no such sequence"}}) {
+    const Result bad = RunIrbench(args, dir);
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+    EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "s2"));
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

@@ -1,0 +1,366 @@
+#include "ci/score/score.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+#include <fstream>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+namespace {
+
+using Json = nlohmann::json;
+
+std::vector<Json> ReadJsonLines(const fs::path& path, std::map<int, Json>* by_frame) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), "", "cannot read (no such file?)");
+  std::vector<Json> lines;
+  std::string text;
+  for (int line = 1; std::getline(in, text); ++line) {
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    Json j;
+    try {
+      j = Json::parse(text);
+    } catch (const Json::parse_error& e) {
+      throw InputError(path.string(), "line " + std::to_string(line), std::string("not JSON: ") + e.what());
+    }
+    if (!j.is_object() || !j.contains("frame") || !j["frame"].is_number_integer()) {
+      throw InputError(path.string(), "line " + std::to_string(line) + ": frame", "missing or not an integer");
+    }
+    const int frame = j["frame"];
+    if (by_frame->count(frame)) {
+      throw InputError(path.string(), "line " + std::to_string(line) + ": frame",
+                       "frame " + std::to_string(frame) + " appears twice");
+    }
+    j["_line"] = line;
+    (*by_frame)[frame] = j;
+    lines.push_back(j);
+  }
+  return lines;
+}
+
+// A point [x, y, z]; nullopt for null or absent; InputError otherwise.
+std::optional<Eigen::Vector3d> Point(const Json& parent, const std::string& key, const fs::path& file,
+                                     const Json& line) {
+  if (!parent.is_object() || !parent.contains(key) || parent[key].is_null()) return std::nullopt;
+  const Json& v = parent[key];
+  if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number()) {
+    throw InputError(file.string(), "line " + std::to_string(line["_line"].get<int>()) + ": " + key,
+                     "expected [x, y, z] in metres");
+  }
+  return Eigen::Vector3d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
+}
+
+const Json* Child(const Json& j, const std::string& key) {
+  return j.is_object() && j.contains(key) && !j[key].is_null() ? &j[key] : nullptr;
+}
+
+std::string Fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+std::string Title(const std::string& joint) {
+  std::string out;
+  bool up = true;
+  for (char c : joint) {
+    if (c == '_') {
+      out += ' ';
+      up = true;
+    } else {
+      out += up ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : c;
+      up = false;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<bool> ChauvenetOutliers(const std::vector<double>& samples) {
+  const size_t n = samples.size();
+  std::vector<bool> out(n, false);
+  if (n < 3) return out;
+  double mean = 0;
+  for (double x : samples) mean += x / n;
+  double var = 0;
+  for (double x : samples) var += (x - mean) * (x - mean) / n;
+  const double sd = std::sqrt(var);
+  if (!(sd > 0)) return out;
+  for (size_t i = 0; i < n; ++i) {
+    const double p = std::erfc(std::abs(samples[i] - mean) / (sd * std::sqrt(2.0)));
+    out[i] = n * p < 0.5;
+  }
+  return out;
+}
+
+ErrorStats Summarise(const std::vector<double>& errors, int missing) {
+  ErrorStats s;
+  s.total = static_cast<int>(errors.size());
+  s.missing = missing;
+  const std::vector<bool> outlier = ChauvenetOutliers(errors);
+  std::vector<double> kept;
+  for (size_t i = 0; i < errors.size(); ++i) {
+    if (outlier[i]) {
+      ++s.outliers;
+    } else {
+      kept.push_back(errors[i]);
+    }
+  }
+  if (kept.empty()) return s;
+  for (double e : kept) s.mean += e / kept.size();
+  for (double e : kept) {
+    s.std += (e - s.mean) * (e - s.mean) / kept.size();
+    s.max = std::max(s.max, e);
+  }
+  s.std = std::sqrt(s.std);
+  return s;
+}
+
+const std::vector<std::string>& ScoredJoints() {
+  static const std::vector<std::string> joints = {"root",           "waist",      "neck",
+                                                  "left_shoulder",  "left_elbow", "left_wrist",
+                                                  "right_shoulder", "right_elbow", "right_wrist"};
+  return joints;
+}
+
+Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const ScoreOptions& options) {
+  std::map<int, Json> truth_by_frame, track_by_frame;
+  const std::vector<Json> truth_lines = ReadJsonLines(truth_jsonl, &truth_by_frame);
+  ReadJsonLines(track_jsonl, &track_by_frame);
+  Score score;
+  score.truth_frames = static_cast<int>(truth_lines.size());
+  std::map<std::string, std::vector<double>> joint_errors, pointing_errors;
+  std::map<std::string, std::vector<int>> joint_frames, pointing_frames;
+  std::map<std::string, int> joint_missing, pointing_missing;
+  for (const auto& [frame, truth] : truth_by_frame) {
+    if (!truth.value("present", false)) continue;
+    ++score.present_frames;
+    const auto it = track_by_frame.find(frame);
+    const Json* track = it == track_by_frame.end() ? nullptr : &it->second;
+    const bool tracking = track && track->value("state", "tracking") == "tracking";
+    score.tracked_frames += tracking;
+    const Json* truth_joints = Child(truth, "joints3d");
+    const Json* track_joints = tracking ? Child(*track, "joints3d") : nullptr;
+    const Json* truth_labels_node = Child(truth, "labels");
+    const Json* truth_rest = truth_labels_node ? Child(*truth_labels_node, "rest") : nullptr;
+    for (const std::string& joint : ScoredJoints()) {
+      const auto t = truth_joints ? Point(*truth_joints, joint, truth_jsonl, truth) : std::nullopt;
+      if (!t) continue;
+      // Thesis 6.6: joints of an arm at rest in the truth are not scored.
+      if (!options.include_rest_arms && truth_rest && (joint.find("elbow") != std::string::npos ||
+                                                       joint.find("wrist") != std::string::npos)) {
+        const std::string side = joint.rfind("left", 0) == 0 ? "left" : "right";
+        if (truth_rest->value(side, false)) continue;
+      }
+      const auto p = track_joints ? Point(*track_joints, joint, track_jsonl, *track) : std::nullopt;
+      if (!p) {
+        ++joint_missing[joint];
+        continue;
+      }
+      joint_errors[joint].push_back(100.0 * (*p - *t).norm());
+      joint_frames[joint].push_back(frame);
+    }
+    // Pointing: where the truth has a pointing ray for that hand.
+    const Json* truth_pointing = Child(truth, "pointing");
+    const Json* track_pointing = tracking ? Child(*track, "pointing") : nullptr;
+    for (const std::string side : {"right", "left"}) {
+      const Json* tp = truth_pointing ? Child(*truth_pointing, side) : nullptr;
+      if (!tp) continue;
+      const auto truth_dir = Point(*tp, "dir", truth_jsonl, truth);
+      if (!truth_dir) continue;
+      const Json* kp = track_pointing ? Child(*track_pointing, side) : nullptr;
+      const auto dir = kp ? Point(*kp, "dir", track_jsonl, *track) : std::nullopt;
+      if (!dir || dir->norm() == 0) {
+        ++pointing_missing[side];
+        continue;
+      }
+      const double c = std::clamp(dir->normalized().dot(truth_dir->normalized()), -1.0, 1.0);
+      // atan2 keeps small angles exact where acos loses them.
+      const double angle = std::atan2(dir->normalized().cross(truth_dir->normalized()).norm(), c);
+      pointing_errors[side].push_back(angle * 180.0 / M_PI);
+      pointing_frames[side].push_back(frame);
+    }
+    // Rest state per arm.
+    const Json* track_rest = tracking ? Child(*track, "rest") : nullptr;
+    for (const std::string side : {"right", "left"}) {
+      if (!truth_rest || !truth_rest->contains(side) || !(*truth_rest)[side].is_boolean()) continue;
+      const bool truth_value = (*truth_rest)[side];
+      if (!track_rest || !track_rest->contains(side) || !(*track_rest)[side].is_boolean()) {
+        ++score.rest[side].missing;
+        ++score.rest["both"].missing;
+        continue;
+      }
+      const bool ok = (*track_rest)[side].get<bool>() == truth_value;
+      for (const std::string key : {side, std::string("both")}) {
+        ++score.rest[key].total;
+        score.rest[key].correct += ok;
+      }
+    }
+    // Motion labels per arm.
+    const Json* truth_labels = Child(truth, "labels");
+    const Json* truth_motion = truth_labels ? Child(*truth_labels, "motion") : nullptr;
+    const Json* track_motion = tracking ? Child(*track, "motion") : nullptr;
+    for (const std::string side : {"right", "left"}) {
+      if (!truth_motion || !truth_motion->contains(side) || !(*truth_motion)[side].is_string()) continue;
+      const std::string truth_label = (*truth_motion)[side];
+      if (!track_motion || !track_motion->contains(side) || !(*track_motion)[side].is_string()) {
+        ++score.motion.missing;
+        continue;
+      }
+      const std::string label = (*track_motion)[side];
+      ++score.motion_confusion[truth_label][label];
+      ++score.motion.total;
+      score.motion.correct += label == truth_label;
+    }
+  }
+  for (const std::string& joint : ScoredJoints()) {
+    score.joints[joint] = Summarise(joint_errors[joint], joint_missing[joint]);
+    const std::vector<bool> out = ChauvenetOutliers(joint_errors[joint]);
+    for (size_t i = 0; i < joint_errors[joint].size(); ++i) {
+      score.joint_errors[joint].emplace_back(joint_frames[joint][i], joint_errors[joint][i], out[i]);
+    }
+  }
+  for (const std::string side : {"right", "left"}) {
+    score.pointing[side] = Summarise(pointing_errors[side], pointing_missing[side]);
+    const std::vector<bool> out = ChauvenetOutliers(pointing_errors[side]);
+    for (size_t i = 0; i < pointing_errors[side].size(); ++i) {
+      score.pointing_errors[side].emplace_back(pointing_frames[side][i], pointing_errors[side][i], out[i]);
+    }
+  }
+  return score;
+}
+
+nlohmann::json Score::ToJson() const {
+  auto stats = [](const ErrorStats& s) {
+    return Json{{"mean", s.mean}, {"std", s.std}, {"outliers", s.outliers}, {"total", s.total},
+                {"missing", s.missing}, {"max", s.max}};
+  };
+  Json j;
+  j["format"] = "irbench.score/1";
+  j["frames"] = {{"truth", truth_frames}, {"present", present_frames}, {"tracked", tracked_frames}};
+  j["joints_cm"] = Json::object();
+  for (const auto& [name, s] : joints) j["joints_cm"][name] = stats(s);
+  j["pointing_deg"] = Json::object();
+  for (const auto& [side, s] : pointing) j["pointing_deg"][side] = stats(s);
+  j["rest"] = Json::object();
+  for (const auto& [side, a] : rest) {
+    j["rest"][side] = {{"accuracy", a.total ? Json(a.rate()) : Json(nullptr)},
+                       {"correct", a.correct}, {"total", a.total}, {"missing", a.missing}};
+  }
+  j["motion_labels"] = {{"accuracy", motion.total ? Json(motion.rate()) : Json(nullptr)},
+                        {"total", motion.total},
+                        {"missing", motion.missing},
+                        {"confusion", motion_confusion}};
+  return j;
+}
+
+std::string Score::Markdown() const {
+  std::ostringstream out;
+  out << "Frames: " << truth_frames << " in the truth, " << present_frames << " with the person on the stage, "
+      << tracked_frames << " of those tracked.\n\n";
+  out << "**Joint errors, cm** (thesis Table 6.1; outliers by Chauvenet's criterion)\n\n"
+      << "| Joint | Mean | Std | Outliers | Total | Missing |\n|---|---|---|---|---|---|\n";
+  for (const std::string& joint : ScoredJoints()) {
+    const ErrorStats& s = joints.at(joint);
+    out << "| " << Title(joint) << " | " << (s.total ? Fixed(s.mean, 2) : "–") << " | "
+        << (s.total ? Fixed(s.std, 2) : "–") << " | " << s.outliers << " | " << s.total << " | " << s.missing
+        << " |\n";
+  }
+  out << "\n**Pointing errors, degrees** (thesis Table 6.3)\n\n"
+      << "| Hand | Mean | Std | Outliers | Total | Missing |\n|---|---|---|---|---|---|\n";
+  for (const std::string side : {"right", "left"}) {
+    const ErrorStats& s = pointing.at(side);
+    out << "| " << Title(side) << " hand | " << (s.total ? Fixed(s.mean, 2) : "–") << " | "
+        << (s.total ? Fixed(s.std, 2) : "–") << " | " << s.outliers << " | " << s.total << " | " << s.missing
+        << " |\n";
+  }
+  out << "\n**Rest state** (thesis 6.4)\n\n| Arm | Accuracy | Frames | Missing |\n|---|---|---|---|\n";
+  for (const std::string side : {"right", "left", "both"}) {
+    const auto it = rest.find(side);
+    const Accuracy a = it == rest.end() ? Accuracy{} : it->second;
+    out << "| " << Title(side) << " | " << (a.total ? Fixed(100 * a.rate(), 2) + "%" : "–") << " | " << a.total
+        << " | " << a.missing << " |\n";
+  }
+  if (!motion_confusion.empty()) {
+    std::vector<std::string> labels;
+    for (const auto& [t, row] : motion_confusion) {
+      labels.push_back(t);
+      for (const auto& [l, n] : row) labels.push_back(l);
+    }
+    std::sort(labels.begin(), labels.end());
+    labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+    out << "\n**Motion labels** (thesis Tables 7.1-7.2; rows truth, columns tracked; accuracy "
+        << Fixed(100 * motion.rate(), 2) << "%)\n\n| |";
+    for (const std::string& l : labels) out << " " << l << " |";
+    out << "\n|---|";
+    for (size_t i = 0; i < labels.size(); ++i) out << "---|";
+    out << "\n";
+    for (const std::string& t : labels) {
+      const auto row = motion_confusion.find(t);
+      if (row == motion_confusion.end()) continue;
+      out << "| " << t << " |";
+      for (const std::string& l : labels) {
+        const auto c = row->second.find(l);
+        out << " " << (c == row->second.end() ? 0 : c->second) << " |";
+      }
+      out << "\n";
+    }
+  }
+  return out.str();
+}
+
+fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary) {
+  const fs::path truth = options.sequence / "truth" / "frames.jsonl";
+  if (!fs::is_directory(options.sequence)) throw InputError(options.sequence.string(), "", "no such sequence folder");
+  if (!fs::is_regular_file(truth)) throw InputError(truth.string(), "", "missing: the sequence has no truth");
+  const fs::path track = options.track.empty() ? options.sequence / "track" / "track.jsonl" : options.track;
+  if (!fs::is_regular_file(track)) {
+    throw InputError(track.string(), "--track", "no such track file (irbench track writes one; or give --track)");
+  }
+  const Score score = ScoreTrack(truth, track, options.score);
+  const fs::path out = options.out.empty() ? options.sequence / "score" : options.out;
+  StagingDir staging(out, options.overwrite, "--out");
+  nlohmann::json j = score.ToJson();
+  j["truth"] = fs::absolute(truth).lexically_normal().string();
+  j["track"] = fs::absolute(track).lexically_normal().string();
+  AtomicWriteFile(staging.path() / "score.json", j.dump(2) + "\n");
+  const std::string md = score.Markdown();
+  AtomicWriteFile(staging.path() / "tables.md", md);
+  std::ostringstream joints_csv;
+  joints_csv << "joint,mean_cm,std_cm,outliers,total,missing,max_cm\n";
+  for (const std::string& joint : ScoredJoints()) {
+    const ErrorStats& s = score.joints.at(joint);
+    joints_csv << joint << "," << s.mean << "," << s.std << "," << s.outliers << "," << s.total << "," << s.missing
+               << "," << s.max << "\n";
+  }
+  for (const std::string side : {"right", "left"}) {
+    const ErrorStats& s = score.pointing.at(side);
+    joints_csv << "pointing_" << side << "_deg," << s.mean << "," << s.std << "," << s.outliers << "," << s.total
+               << "," << s.missing << "," << s.max << "\n";
+  }
+  AtomicWriteFile(staging.path() / "joints.csv", joints_csv.str());
+  std::ostringstream errors_csv;
+  errors_csv << "frame,what,error,unit,outlier\n";
+  for (const auto& [joint, rows] : score.joint_errors) {
+    for (const auto& [frame, e, outlier] : rows) errors_csv << frame << "," << joint << "," << e << ",cm," << outlier << "\n";
+  }
+  for (const auto& [side, rows] : score.pointing_errors) {
+    for (const auto& [frame, e, outlier] : rows) {
+      errors_csv << frame << ",pointing_" << side << "," << e << ",deg," << outlier << "\n";
+    }
+  }
+  AtomicWriteFile(staging.path() / "errors.csv", errors_csv.str());
+  staging.Commit();
+  if (summary) *summary = md;
+  return staging.final_path();
+}
+
+}  // namespace irbench

@@ -1,0 +1,91 @@
+#pragma once
+// Scoring tracker output against the truth in the thesis's shapes (thesis
+// 6.6): per-joint 3D error mean, standard deviation, outliers by Chauvenet's
+// criterion and total (Table 6.1); pointing angle error per hand (Table 6.3);
+// rest-state accuracy (6.4); motion-label confusion per arm (Tables 7.1-7.2).
+//
+// Inputs: the sequence's truth/frames.jsonl and a track.jsonl (docs/formats.md,
+// "Tracker output"), matched by frame index. Only frames where the truth says
+// the person is `present` count. A value the tracker left null (or a frame it
+// did not write, or wrote with state "empty") is "missing": counted, never
+// scored as an error. As in the thesis, the elbow and wrist of an arm the truth
+// labels at rest are left out of the joint errors (ScoreOptions).
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace irbench {
+
+// Chauvenet's criterion, one pass: sample i is an outlier when
+// n * erfc(|x_i - mean| / (std * sqrt 2)) < 0.5, mean and std (population) over
+// all n samples. Returns one flag per sample; none when n < 3 or std is 0.
+std::vector<bool> ChauvenetOutliers(const std::vector<double>& samples);
+
+struct ErrorStats {
+  double mean = 0, std = 0;  // over the samples that are not outliers
+  int outliers = 0;          // removed by Chauvenet's criterion
+  int total = 0;             // samples scored (outliers included), as the thesis's "Total"
+  int missing = 0;           // frames where the truth has it and the track does not
+  double max = 0;            // largest error kept
+};
+
+// Mean, std, outliers and total of `errors` (Chauvenet applied).
+ErrorStats Summarise(const std::vector<double>& errors, int missing);
+
+struct ScoreOptions {
+  bool include_rest_arms = false;  // score elbows and wrists of arms at rest too
+};
+
+// The nine joints of Table 6.1, in its order.
+const std::vector<std::string>& ScoredJoints();
+
+struct Score {
+  int truth_frames = 0;    // lines in truth/frames.jsonl
+  int present_frames = 0;  // of which the person is on the stage
+  int tracked_frames = 0;  // present frames the track has with state "tracking"
+  std::map<std::string, ErrorStats> joints;  // centimetres
+  // Per-frame errors (cm) for plots: joint -> (frame, error, outlier).
+  std::map<std::string, std::vector<std::tuple<int, double, bool>>> joint_errors;
+  std::map<std::string, ErrorStats> pointing;  // "right", "left": degrees
+  std::map<std::string, std::vector<std::tuple<int, double, bool>>> pointing_errors;
+  // Rest state: agreement per arm and both.
+  struct Accuracy {
+    int correct = 0, total = 0, missing = 0;
+    double rate() const { return total ? double(correct) / total : 0.0; }
+  };
+  std::map<std::string, Accuracy> rest;  // "right", "left", "both"
+  // Motion labels: truth label -> tracked label -> count, both arms together.
+  std::map<std::string, std::map<std::string, int>> motion_confusion;
+  Accuracy motion;
+
+  nlohmann::json ToJson() const;
+  // The tables as GitHub-flavoured Markdown.
+  std::string Markdown() const;
+};
+
+// Reads both files and scores. Throws InputError naming the file and line for
+// unreadable or malformed input (a truth or track line that is not JSON, a
+// joint that is not three numbers, a frame index that is not an integer).
+Score ScoreTrack(const std::filesystem::path& truth_jsonl, const std::filesystem::path& track_jsonl,
+                 const ScoreOptions& options = {});
+
+struct ScoreJobOptions {
+  std::filesystem::path sequence;
+  std::filesystem::path track;  // default: <sequence>/track/track.jsonl
+  std::filesystem::path out;    // default: <sequence>/score
+  bool overwrite = false;
+  ScoreOptions score;
+};
+
+// `irbench score`: writes score.json, tables.md, joints.csv (per-joint
+// summary), errors.csv (per frame and joint/hand) into `out` (complete or not
+// at all). Returns the folder; `summary` (if given) receives the Markdown.
+std::filesystem::path RunScoreJob(const ScoreJobOptions& options, std::string* summary = nullptr);
+
+}  // namespace irbench

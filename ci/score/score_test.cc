@@ -1,0 +1,198 @@
+// The scorer on track files made from a rendered sequence's truth with known
+// perturbations: it must report exactly those figures, and Chauvenet's
+// criterion must remove exactly the injected outliers.
+
+#include "ci/score/score.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <fstream>
+#include <random>
+
+#include "common/error.h"
+#include "sim/sequence/render_job.h"
+#include "tests/test_util.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+TEST(ChauvenetTest, RemovesOnlyTheFarSamples) {
+  std::vector<double> x(100, 3.0);
+  x[7] = 40, x[50] = 35;
+  const auto out = ChauvenetOutliers(x);
+  for (size_t i = 0; i < x.size(); ++i) EXPECT_EQ(out[i], i == 7 || i == 50) << i;
+  // A normal sample of 1000: the criterion expects to flag about
+  // n * P(|z| > z_c) with n erfc(z_c / sqrt 2) = 0.5, i.e. half a sample.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> normal(5, 2);
+  std::vector<double> y(1000);
+  for (double& v : y) v = normal(rng);
+  int flagged = 0;
+  for (bool b : ChauvenetOutliers(y)) flagged += b;
+  EXPECT_LE(flagged, 3);
+  EXPECT_TRUE(ChauvenetOutliers({1, 1, 1}) == std::vector<bool>(3, false));  // std 0
+  const ErrorStats s = Summarise(x, 4);
+  EXPECT_EQ(s.outliers, 2);
+  EXPECT_EQ(s.total, 100);
+  EXPECT_EQ(s.missing, 4);
+  EXPECT_NEAR(s.mean, 3.0, 1e-12);
+  EXPECT_NEAR(s.std, 0.0, 1e-6);
+}
+
+class ScoreTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = irbench::testing::FreshTempDir("score");
+    irbench::testing::WriteText(dir_ / "s.json", R"({"format": "irbench.session/1", "crossfade_s": 0.2, "items": [
+      {"motion": "point", "target": "helicopter", "side": "right", "hold_s": 0.8},
+      {"motion": "raise_overhead", "side": "left", "hold_s": 0.3}]})");
+    RenderJobOptions options;
+    options.rig = "lab4";
+    options.scene = "theater";
+    options.motion = (dir_ / "s.json").string();
+    options.background_frames = 0;
+    options.supersample = 1;
+    options.out = dir_ / "seq";
+    RunRenderJob(options);
+    std::ifstream in(dir_ / "seq/truth/frames.jsonl");
+    for (std::string line; std::getline(in, line);) truth_.push_back(Json::parse(line));
+  }
+  // A track line that says exactly what the truth says.
+  static Json Perfect(const Json& t) {
+    Json j = {{"frame", t["frame"]}, {"state", "tracking"}, {"joints3d", t["joints3d"]}};
+    j["pointing"] = Json::object();
+    for (const char* side : {"right", "left"}) {
+      j["pointing"][side] = t["pointing"][side].is_null() ? Json(nullptr) : Json{{"dir", t["pointing"][side]["dir"]}};
+    }
+    j["rest"] = t["labels"]["rest"];
+    j["motion"] = t["labels"]["motion"];
+    return j;
+  }
+  static void Write(const fs::path& path, const std::vector<Json>& lines) {
+    std::ofstream out(path);
+    for (const Json& j : lines) out << j.dump() << "\n";
+  }
+  static fs::path dir_;
+  static std::vector<Json> truth_;
+};
+fs::path ScoreTest::dir_;
+std::vector<Json> ScoreTest::truth_;
+
+TEST_F(ScoreTest, PerfectTrackScoresZero) {
+  std::vector<Json> track;
+  for (const Json& t : truth_) track.push_back(Perfect(t));
+  Write(dir_ / "perfect.jsonl", track);
+  const Score s = ScoreTrack(dir_ / "seq/truth/frames.jsonl", dir_ / "perfect.jsonl");
+  EXPECT_EQ(s.truth_frames, int(truth_.size()));
+  EXPECT_GT(s.present_frames, 40);
+  EXPECT_EQ(s.tracked_frames, s.present_frames);
+  for (const auto& [joint, e] : s.joints) {
+    EXPECT_EQ(e.mean, 0.0) << joint;
+    EXPECT_EQ(e.outliers, 0) << joint;
+    EXPECT_EQ(e.missing, 0) << joint;
+  }
+  EXPECT_EQ(s.joints.at("neck").total, s.present_frames);
+  EXPECT_GT(s.pointing.at("right").total, 10);
+  EXPECT_LT(s.pointing.at("right").mean, 1e-6);
+  EXPECT_EQ(s.rest.at("both").rate(), 1.0);
+  EXPECT_EQ(s.motion.rate(), 1.0);
+}
+
+TEST_F(ScoreTest, ReportsExactlyTheInjectedErrors) {
+  std::vector<Json> track;
+  std::vector<int> outlier_frames;
+  int present = 0, rest_flips = 0, nulls = 0;
+  for (const Json& t : truth_) {
+    Json j = Perfect(t);
+    const int f = t["frame"];
+    // A constant 3 cm offset on the right elbow (where it is scored: not at rest).
+    j["joints3d"]["right_elbow"][0] = t["joints3d"]["right_elbow"][0].get<double>() + 0.03;
+    // Outliers: the neck 40 cm off on every 17th present frame.
+    if (t["present"] && present++ % 17 == 5) {
+      j["joints3d"]["neck"][2] = t["joints3d"]["neck"][2].get<double>() + 0.40;
+      outlier_frames.push_back(f);
+    }
+    // The right pointing ray turned by exactly 2 degrees about an axis across it.
+    if (!t["pointing"]["right"].is_null()) {
+      const Eigen::Vector3d d(t["pointing"]["right"]["dir"][0], t["pointing"]["right"]["dir"][1],
+                              t["pointing"]["right"]["dir"][2]);
+      const Eigen::Vector3d axis = d.cross(Eigen::Vector3d::UnitZ()).normalized();
+      const Eigen::Vector3d r = Eigen::AngleAxisd(2.0 * M_PI / 180.0, axis) * d;
+      j["pointing"]["right"]["dir"] = {r.x(), r.y(), r.z()};
+    }
+    // The left rest flag wrong on every 10th frame; the waist missing on every 9th.
+    if (t["present"] && f % 10 == 3) {
+      j["rest"]["left"] = !t["labels"]["rest"]["left"].get<bool>();
+      ++rest_flips;
+    }
+    if (t["present"] && f % 9 == 4) {
+      j["joints3d"]["waist"] = nullptr;
+      ++nulls;
+    }
+    track.push_back(j);
+  }
+  Write(dir_ / "perturbed.jsonl", track);
+  ScoreJobOptions job;
+  job.sequence = dir_ / "seq";
+  job.track = dir_ / "perturbed.jsonl";
+  job.out = dir_ / "score";
+  std::string md;
+  const fs::path out = RunScoreJob(job, &md);
+  const Score s = ScoreTrack(dir_ / "seq/truth/frames.jsonl", dir_ / "perturbed.jsonl");
+  const ErrorStats& elbow = s.joints.at("right_elbow");
+  EXPECT_NEAR(elbow.mean, 3.0, 1e-9);
+  EXPECT_NEAR(elbow.std, 0.0, 1e-9);
+  EXPECT_EQ(elbow.outliers, 0);
+  const ErrorStats& neck = s.joints.at("neck");
+  EXPECT_EQ(neck.outliers, int(outlier_frames.size()));
+  EXPECT_EQ(neck.mean, 0.0);  // what is left is exact
+  int flagged_right = 0;
+  for (const auto& [frame, e, outlier] : s.joint_errors.at("neck")) {
+    const bool injected = std::find(outlier_frames.begin(), outlier_frames.end(), frame) != outlier_frames.end();
+    EXPECT_EQ(outlier, injected) << "frame " << frame;
+    flagged_right += outlier && injected;
+  }
+  EXPECT_EQ(flagged_right, int(outlier_frames.size()));
+  EXPECT_NEAR(s.pointing.at("right").mean, 2.0, 1e-9);
+  EXPECT_LT(s.pointing.at("left").mean, 1e-6);
+  EXPECT_EQ(s.joints.at("waist").missing, nulls);
+  EXPECT_EQ(s.joints.at("waist").total, s.present_frames - nulls);
+  EXPECT_EQ(s.rest.at("left").total - s.rest.at("left").correct, rest_flips);
+  EXPECT_EQ(s.rest.at("right").rate(), 1.0);
+  // The files the job wrote say the same.
+  const Json j = Json::parse(irbench::testing::ReadText(out / "score.json"));
+  EXPECT_NEAR(j["joints_cm"]["right_elbow"]["mean"].get<double>(), 3.0, 1e-9);
+  EXPECT_EQ(j["joints_cm"]["neck"]["outliers"], int(outlier_frames.size()));
+  EXPECT_NE(md.find("| Right Elbow | 3.00 | 0.00 | 0 |"), std::string::npos) << md;
+  EXPECT_NE(irbench::testing::ReadText(out / "tables.md").find("Table 6.3"), std::string::npos);
+  EXPECT_NE(irbench::testing::ReadText(out / "joints.csv").find("right_elbow,3,"), std::string::npos);
+}
+
+TEST_F(ScoreTest, BadTrackFilesNameTheLine) {
+  std::vector<Json> track;
+  for (const Json& t : truth_) track.push_back(Perfect(t));
+  track[3]["joints3d"]["neck"] = {1, 2};
+  Write(dir_ / "bad.jsonl", track);
+  try {
+    ScoreTrack(dir_ / "seq/truth/frames.jsonl", dir_ / "bad.jsonl");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "line 4: neck") << e.what();
+  }
+  irbench::testing::WriteText(dir_ / "bad2.jsonl", "{\"frame\": 0}\n{not json\n");
+  try {
+    ScoreTrack(dir_ / "seq/truth/frames.jsonl", dir_ / "bad2.jsonl");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "line 2") << e.what();
+  }
+  ScoreJobOptions job;
+  job.sequence = dir_ / "seq";  // no track/track.jsonl there
+  EXPECT_THROW(RunScoreJob(job), InputError);
+}
+
+}  // namespace
+}  // namespace irbench
