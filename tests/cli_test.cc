@@ -60,7 +60,7 @@ TEST(CliTest, HelpOnEveryCommand) {
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
         {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
         {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
-        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}}) {
+        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
@@ -346,6 +346,22 @@ TEST(CliTest, ScorePrintsTheTablesAndRefusesBadInput) {
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
   EXPECT_FALSE(fs::exists(dir / "s2"));
+}
+
+TEST(CliTest, DemoRendersTracksAndScores) {
+  const fs::path dir = FreshTempDir("cli_demo");
+  const Result r = RunIrbench({"demo", "--frames", "8", "--out", (dir / "demo").string()}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| Joint | Mean | Std | Outliers | Total | Missing |"), std::string::npos) << r.out;
+  for (const char* file : {"manifest.json", "track/track.jsonl", "track/features.jsonl", "score/score.json",
+                           "score/tables.md"}) {
+    EXPECT_TRUE(fs::exists(dir / "demo" / file)) << file;
+  }
+  // Again without --force: refused, the first run kept.
+  const Result again = RunIrbench({"demo", "--frames", "8", "--out", (dir / "demo").string()}, dir);
+  EXPECT_EQ(again.exit_code, 2);
+  EXPECT_NE(again.err.find("exists"), std::string::npos) << again.err;
+  EXPECT_TRUE(fs::exists(dir / "demo" / "score/score.json"));
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

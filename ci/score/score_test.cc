@@ -5,6 +5,7 @@
 #include "ci/score/score.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <fstream>
@@ -45,7 +46,8 @@ TEST(ChauvenetTest, RemovesOnlyTheFarSamples) {
 class ScoreTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = irbench::testing::FreshTempDir("score");
+    // ctest runs each test in its own process, maybe at once: a folder per process.
+    dir_ = irbench::testing::FreshTempDir("score_" + std::to_string(::getpid()));
     irbench::testing::WriteText(dir_ / "s.json", R"({"format": "irbench.session/1", "crossfade_s": 0.2, "items": [
       {"motion": "point", "target": "helicopter", "side": "right", "hold_s": 0.8},
       {"motion": "raise_overhead", "side": "left", "hold_s": 0.3}]})");
@@ -75,6 +77,7 @@ class ScoreTest : public ::testing::Test {
     std::ofstream out(path);
     for (const Json& j : lines) out << j.dump() << "\n";
   }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
   static fs::path dir_;
   static std::vector<Json> truth_;
 };

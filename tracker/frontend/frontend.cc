@@ -15,6 +15,22 @@ void FrontEndOptions::Check() const {
   polyhedral.Check();
 }
 
+std::optional<BodyPlacement> PlaceBody(const VoxelHull& hull, double legs_height_m, double min_volume_m3) {
+  if (hull.VolumeM3() < min_volume_m3) return std::nullopt;
+  BodyPlacement p;
+  p.volume_m3 = hull.VolumeM3();
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  int count = 0;
+  p.top_m = 0;
+  for (const Eigen::Vector3d& c : hull.OccupiedCenters()) {
+    p.top_m = std::max(p.top_m, c.z() + 0.5 * hull.voxel_size_m);
+    if (c.z() < legs_height_m) sum += c.head<2>(), ++count;
+  }
+  if (count == 0) return std::nullopt;  // floating blob: not a person standing
+  p.root = Eigen::Vector3d(sum.x() / count, sum.y() / count, 0);
+  return p;
+}
+
 cv::Mat ScreenMask(const Camera& camera, const std::vector<ScreenSurface>& screens) {
   cv::Mat mask = cv::Mat::zeros(camera.height, camera.width, CV_8U);
   if (screens.empty()) return mask;
@@ -92,6 +108,7 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
   if (carver_) {
     t = std::chrono::steady_clock::now();
     out.voxels = carver_->Carve(silhouettes);
+    out.placement = PlaceBody(*out.voxels);
     out.ms_voxels = since(t);
   }
   if (options_.polyhedral_hull) {

@@ -41,6 +41,19 @@ struct CameraFeatures {
   int blobs_removed = 0;
 };
 
+// Where the person stands, from the voxel hull (thesis 6.1.2 places the body
+// from its 3D shape): the floor point under the centroid of the occupied
+// voxels below `legs_height_m` (legs and feet: the arms do not pull it), and
+// the hull's top. nullopt when the hull holds less than `min_volume_m3`
+// (an empty stage).
+struct BodyPlacement {
+  Eigen::Vector3d root = Eigen::Vector3d::Zero();  // z = 0
+  double top_m = 0;
+  double volume_m3 = 0;
+};
+std::optional<BodyPlacement> PlaceBody(const VoxelHull& hull, double legs_height_m = 0.5,
+                                       double min_volume_m3 = 0.02);
+
 struct FrameFeatures {
   int frame = 0;
   std::vector<CameraFeatures> cameras;
@@ -51,6 +64,7 @@ struct FrameFeatures {
   std::vector<SilhouettePolygons> polygons;  // per camera
   std::optional<VoxelHull> voxels;
   std::optional<HullMesh> hull;  // the polyhedral hull (not watertight)
+  std::optional<BodyPlacement> placement;  // nullopt: the stage looks empty
   double ms_silhouettes = 0;  // wall time of each stage for all cameras
   double ms_axes = 0;
   double ms_polygons = 0;

@@ -118,7 +118,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   Log().info("track: background models for {} cameras from {} empty-stage frames in {:.0f} ms",
              input.cameras().size(), input.background_count(), train_ms);
 
-  std::string lines;
+  std::string lines, track_lines;
   const auto start = std::chrono::steady_clock::now();
   auto last_report = start;
   for (int f = 0; f < frames; ++f) {
@@ -173,6 +173,25 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                                        {"triangles", features.hull->triangles.size()},
                                        {"volume_m3", std::round(MeshVolume(*features.hull) * 1e5) / 1e5}}
                       : nlohmann::json(nullptr);
+    // track.jsonl (docs/formats.md, "Tracker output"): what the stages built
+    // so far know; everything else null, never invented.
+    nlohmann::json track_line;
+    track_line["frame"] = f;
+    track_line["t"] = f / input.fps();
+    track_line["state"] = features.placement ? "tracking" : "empty";
+    nlohmann::json joints = nlohmann::json::object();
+    for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
+                             "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip"}) {
+      joints[name] = nullptr;
+    }
+    if (features.placement) {
+      const Eigen::Vector3d& r = features.placement->root;
+      joints["root"] = {std::round(r.x() * 1e4) / 1e4, std::round(r.y() * 1e4) / 1e4, 0.0};
+    }
+    track_line["joints3d"] = joints;
+    track_line["height_m"] = features.placement ? nlohmann::json(std::round(features.placement->top_m * 1e3) / 1e3)
+                                                : nlohmann::json(nullptr);
+    for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
     line["ms"] = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes},
                   {"polygons", features.ms_polygons},       {"voxels", features.ms_voxels},
                   {"polyhedral_hull", features.ms_polyhedral}};
@@ -182,7 +201,9 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
       if (features.voxels) WriteVoxelCubesPly(root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
       if (features.hull) WriteMeshPly(root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
     }
+    track_line["ms"] = line["ms"];
     lines += line.dump() + "\n";
+    track_lines += track_line.dump() + "\n";
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {
       Log().info("track: frame {}/{}", f + 1, frames);
@@ -190,6 +211,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     }
   }
   AtomicWriteFile(root / "features.jsonl", lines);
+  AtomicWriteFile(root / "track.jsonl", track_lines);
   nlohmann::json meta = {{"format", "irbench.track-features/1"},
                          {"sequence", fs::absolute(options.sequence).lexically_normal().string()},
                          {"stage", options.stage},

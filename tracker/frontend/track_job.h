@@ -2,6 +2,10 @@
 // `irbench track SEQ --stage features`: runs the front end over a sequence and
 // writes what it found, for inspection and for the later stages.
 //
+//   <out>/track.jsonl              the tracker output (docs/formats.md): state
+//                                  (empty/tracking, from the voxel hull), the
+//                                  root from the hull; the rest null until the
+//                                  pose tracker lands
 //   <out>/features.jsonl           a line per frame: per camera the silhouette's
 //                                  area, the light level, blobs removed; ms per stage
 //   <out>/silhouettes/<cam>/NNNNNN.png   255 person, 0 else

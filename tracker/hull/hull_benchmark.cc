@@ -59,6 +59,23 @@ void BM_VoxelCarve(benchmark::State& state) {
 }
 BENCHMARK(BM_VoxelCarve)->Arg(20)->Arg(25)->Arg(30)->Unit(benchmark::kMillisecond);
 
+// Tolerant carving (max_missing_views 1): a block must be certainly outside
+// two views before it is skipped whole.
+void BM_VoxelCarveTolerant(benchmark::State& state) {
+  const std::vector<Camera> cams = Theater4();
+  VoxelGridOptions options;
+  options.max_missing_views = 1;
+  const VoxelCarver carver(cams, options);
+  const std::vector<cv::Mat> sil = BodySilhouettes(cams);
+  int occupied = 0;
+  for (auto _ : state) {
+    occupied = carver.Carve(sil).occupied_count;
+    benchmark::DoNotOptimize(occupied);
+  }
+  state.counters["occupied"] = occupied;
+}
+BENCHMARK(BM_VoxelCarveTolerant)->Unit(benchmark::kMillisecond);
+
 void BM_VoxelLookUpTable(benchmark::State& state) {
   const std::vector<Camera> cams = Theater4();
   VoxelGridOptions options;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -47,12 +48,24 @@ double VoxelHull::VolumeM3() const {
 std::vector<Eigen::Vector3d> VoxelHull::OccupiedCenters() const {
   std::vector<Eigen::Vector3d> out;
   out.reserve(occupied_count);
-  for (int z = 0; z < nz; ++z) {
-    for (int y = 0; y < ny; ++y) {
-      for (int x = 0; x < nx; ++x) {
-        if (Occupied(x, y, z)) out.push_back(VoxelCenter(x, y, z));
+  // In index order (z, then y, then x), skipping empty runs 8 voxels at a time.
+  const size_t n = occupied.size();
+  const uint8_t* o = occupied.data();
+  for (size_t i = 0; i < n;) {
+    if (i + 8 <= n) {
+      uint64_t word;
+      std::memcpy(&word, o + i, 8);
+      if (word == 0) {
+        i += 8;
+        continue;
       }
     }
+    if (o[i]) {
+      const int x = static_cast<int>(i % nx), y = static_cast<int>((i / nx) % ny),
+                z = static_cast<int>(i / nx / ny);
+      out.push_back(VoxelCenter(x, y, z));
+    }
+    ++i;
   }
   return out;
 }
@@ -92,10 +105,29 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
         ++observed[v];
     }
   }
+  // The candidates, grouped by block (counting sort on the block index; within
+  // a block in voxel index order).
+  const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock,
+            bz = (nz_ + kBlock - 1) / kBlock;
+  auto block_of = [&](size_t v) {
+    const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
+              z = static_cast<int>(v / nx_ / ny_);
+    return (size_t(z / kBlock) * by + y / kBlock) * bx + x / kBlock;
+  };
+  std::vector<uint32_t> per_block(size_t(bx) * by * bz + 1, 0);
+  for (size_t v = 0; v < voxels; ++v) {
+    if (observed[v] >= options_.min_observing_cameras) ++per_block[block_of(v) + 1];
+  }
+  for (size_t b = 1; b < per_block.size(); ++b) {
+    if (per_block[b] > 0) blocks_.push_back({per_block[b - 1], per_block[b]});
+    per_block[b] += per_block[b - 1];
+  }
+  candidates_.resize(per_block.back());
   for (size_t v = 0; v < voxels; ++v) {
     if (observed[v] >= options_.min_observing_cameras)
-      candidates_.push_back(static_cast<uint32_t>(v));
+      candidates_[per_block[block_of(v)]++] = static_cast<uint32_t>(v);
   }
+  per_block = {};
   observed = {};
 
   // Pass 2, per camera: the footprint of every candidate, from the projected
@@ -122,7 +154,6 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
       }
     }
     const int w = cam.width, h = cam.height;
-    Footprint* out = footprints_.data() + c * nk;
     for (size_t k = 0; k < nk; ++k) {
       const size_t v = candidates_[k];
       const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
@@ -148,35 +179,78 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
       // Bilinear interpolation reads the pixel right of and below the floor.
       const double fu = std::clamp(pc.x(), 0.0, w - 1.001), fv = std::clamp(pc.y(), 0.0, h - 1.001);
       const int u0 = static_cast<int>(fu), v0 = static_cast<int>(fv);
-      out[k].pixel = v0 * w + u0;
-      out[k].frac_u = static_cast<uint8_t>(std::min(255.0, std::round((fu - u0) * 256)));
-      out[k].frac_v = static_cast<uint8_t>(std::min(255.0, std::round((fv - v0) * 256)));
-      out[k].radius_q = static_cast<uint16_t>(std::min(65535.0, std::floor(radius * 64)));
+      Footprint& f = footprints_[k * nc + c];
+      f.pixel = v0 * w + u0;
+      f.frac_u = static_cast<uint8_t>(std::min(255.0, std::round((fu - u0) * 256)));
+      f.frac_v = static_cast<uint8_t>(std::min(255.0, std::round((fv - v0) * 256)));
+      f.radius_q = static_cast<uint16_t>(std::min(65535.0, std::floor(radius * 64)));
+    }
+  }
+
+  // Per block and camera: the bounds. Each voxel's test value is the bilinear
+  // interpolation of D at its point q (pixel + frac / 256), at least the least
+  // and at most the greatest of D at the 4 pixel centres around q, each
+  // within sqrt(2) of q. With all q of the block within rho of a point U and g
+  // the pixel centre nearest U, D being 1-Lipschitz bounds all these values by
+  // D[g] -+ (sqrt(2) + rho + |U - g|). The float arithmetic of the test and
+  // of the transform adds error far below kSlackPx.
+  constexpr double kSlackPx = 0.01;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  bounds_.resize(blocks_.size() * nc);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const Block& block = blocks_[b];
+    for (size_t c = 0; c < nc; ++c) {
+      const int w = cameras_[c].width, h = cameras_[c].height;
+      double u_lo = 1e30, u_hi = -1e30, v_lo = 1e30, v_hi = -1e30, r_lo = 1e30, r_hi = 0;
+      bool all_constrained = true;
+      for (uint32_t k = block.first; k < block.first + block.count; ++k) {
+        const Footprint& f = footprints_[size_t(k) * nc + c];
+        if (f.pixel < 0) {
+          all_constrained = false;
+          continue;
+        }
+        const double u = f.pixel % w + f.frac_u / 256.0, v = f.pixel / w + f.frac_v / 256.0;
+        u_lo = std::min(u_lo, u);
+        u_hi = std::max(u_hi, u);
+        v_lo = std::min(v_lo, v);
+        v_hi = std::max(v_hi, v);
+        r_lo = std::min(r_lo, f.radius_q / 64.0);
+        r_hi = std::max(r_hi, f.radius_q / 64.0);
+      }
+      BlockBound& bound = bounds_[b * nc + c];
+      if (u_lo > u_hi) {  // no voxel of the block is constrained: all pass
+        bound = {0, kInf, kInf};
+        continue;
+      }
+      const double cu = 0.5 * (u_lo + u_hi), cv = 0.5 * (v_lo + v_hi);
+      const int gu = std::clamp(static_cast<int>(std::lround(cu)), 0, w - 1),
+                gv = std::clamp(static_cast<int>(std::lround(cv)), 0, h - 1);
+      double rho = 0;
+      for (uint32_t k = block.first; k < block.first + block.count; ++k) {
+        const Footprint& f = footprints_[size_t(k) * nc + c];
+        if (f.pixel < 0) continue;
+        rho = std::max(rho, std::hypot(f.pixel % w + f.frac_u / 256.0 - cu,
+                                       f.pixel / w + f.frac_v / 256.0 - cv));
+      }
+      const double reach = std::sqrt(2.0) + rho + std::hypot(cu - gu, cv - gv) + kSlackPx;
+      bound.pixel = gv * w + gu;
+      // Voxels without a constraint pass, so only a fully constrained block
+      // can be carved whole.
+      bound.carve_above = all_constrained ? static_cast<float>(r_hi + reach) : kInf;
+      bound.keep_below = static_cast<float>(r_lo - reach);
     }
   }
 }
 
-VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
+std::vector<cv::Mat> VoxelCarver::DistanceTransforms(const std::vector<cv::Mat>& silhouettes) const {
   const size_t nc = cameras_.size();
   if (silhouettes.size() != nc) {
     throw InputError("", "silhouettes",
                      "expected " + std::to_string(nc) + " silhouettes, got " +
                          std::to_string(silhouettes.size()));
   }
-  VoxelHull hull;
-  hull.origin_m = options_.min_corner_m;
-  hull.voxel_size_m = options_.voxel_size_m;
-  hull.nx = nx_;
-  hull.ny = ny_;
-  hull.nz = nz_;
-  hull.occupied.assign(size_t(nx_) * ny_ * nz_, 0);
-
-  // Camera by camera: the first streams through all candidates' footprints,
-  // later ones only through the survivors.
-  const size_t nk = candidates_.size();
-  std::vector<uint32_t> alive;
-  std::vector<uint8_t> misses;
-  cv::Mat background, distance;
+  std::vector<cv::Mat> out(nc);
+  cv::Mat background;
   for (size_t c = 0; c < nc; ++c) {
     const cv::Mat& sil = silhouettes[c];
     if (sil.type() != CV_8UC1 || sil.cols != cameras_[c].width || sil.rows != cameras_[c].height) {
@@ -187,45 +261,105 @@ VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
     // (exact Euclidean), pixels.
     cv::threshold(sil, background, 127, 255, cv::THRESH_BINARY_INV);
     if (cv::countNonZero(background) == static_cast<int>(background.total())) {
-      distance = cv::Mat(sil.size(), CV_32F, cv::Scalar(1e6));  // no silhouette: all far
+      out[c] = cv::Mat(sil.size(), CV_32F, cv::Scalar(1e6));  // no silhouette: all far
     } else {
-      cv::distanceTransform(background, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+      cv::distanceTransform(background, out[c], cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
     }
-    const float* dist = distance.ptr<float>();
-    const int w = sil.cols;
-    const Footprint* fp = footprints_.data() + c * nk;
-    auto keep = [&](uint32_t k) {
-      const Footprint& f = fp[k];
-      if (f.pixel < 0) return true;
-      const float* d = dist + f.pixel;
-      const float fu = f.frac_u * (1.0f / 256), fv = f.frac_v * (1.0f / 256);
-      const float top = d[0] + fu * (d[1] - d[0]);
-      const float bottom = d[w] + fu * (d[w + 1] - d[w]);
-      return top + fv * (bottom - top) <= f.radius_q * (1.0f / 64);
-    };
-    const int allowed = options_.max_missing_views;
-    if (allowed > 0) {
-      // Tolerant carving: a voxel goes only when more than `allowed` views
-      // put it outside their silhouettes.
-      if (c == 0) {
-        misses.assign(nk, 0);
-        alive.resize(nk);
-        for (uint32_t k = 0; k < nk; ++k) alive[k] = k;
+    CV_Assert(out[c].isContinuous());
+  }
+  return out;
+}
+
+VoxelHull VoxelCarver::EmptyHull() const {
+  VoxelHull hull;
+  hull.origin_m = options_.min_corner_m;
+  hull.voxel_size_m = options_.voxel_size_m;
+  hull.nx = nx_;
+  hull.ny = ny_;
+  hull.nz = nz_;
+  hull.occupied.assign(size_t(nx_) * ny_ * nz_, 0);
+  return hull;
+}
+
+namespace {
+
+// The per-voxel test (thesis 4.2): the distance transform `dist` (row stride
+// `w`), bilinearly interpolated at the footprint's point, is at most its radius.
+template <typename Footprint>
+inline bool Passes(const float* dist, int w, const Footprint& f) {
+  if (f.pixel < 0) return true;
+  const float* d = dist + f.pixel;
+  const float fu = f.frac_u * (1.0f / 256), fv = f.frac_v * (1.0f / 256);
+  const float top = d[0] + fu * (d[1] - d[0]);
+  const float bottom = d[w] + fu * (d[w + 1] - d[w]);
+  return top + fv * (bottom - top) <= f.radius_q * (1.0f / 64);
+}
+
+}  // namespace
+
+VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
+  const std::vector<cv::Mat> distance = DistanceTransforms(silhouettes);
+  VoxelHull hull = EmptyHull();
+  const size_t nc = cameras_.size();
+  std::vector<const float*> dist(nc);
+  std::vector<int> width(nc);
+  for (size_t c = 0; c < nc; ++c) {
+    dist[c] = distance[c].ptr<float>();
+    width[c] = cameras_[c].width;
+  }
+  const int allowed = options_.max_missing_views;
+  std::vector<int> unsure(nc);  // the cameras to consult per voxel
+  int occupied = 0;
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const BlockBound* bound = bounds_.data() + b * nc;
+    int carved = 0, n_unsure = 0;
+    for (size_t c = 0; c < nc; ++c) {
+      const float d = dist[c][bound[c].pixel];
+      if (d > bound[c].carve_above) {
+        ++carved;
+      } else if (!(d <= bound[c].keep_below)) {
+        unsure[n_unsure++] = static_cast<int>(c);
       }
-      alive.erase(std::remove_if(alive.begin(), alive.end(),
-                                 [&](uint32_t k) { return !keep(k) && ++misses[k] > allowed; }),
-                  alive.end());
-    } else if (c == 0) {
-      for (uint32_t k = 0; k < nk; ++k) {
-        if (keep(k)) alive.push_back(k);
+    }
+    if (carved > allowed) continue;
+    const Block& block = blocks_[b];
+    const uint32_t end = block.first + block.count;
+    if (n_unsure == 0) {
+      for (uint32_t k = block.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+      occupied += static_cast<int>(block.count);
+      continue;
+    }
+    for (uint32_t k = block.first; k < end; ++k) {
+      const Footprint* fp = footprints_.data() + size_t(k) * nc;
+      int misses = carved;
+      for (int i = 0; i < n_unsure && misses <= allowed; ++i) {
+        const int c = unsure[i];
+        misses += !Passes(dist[c], width[c], fp[c]);
       }
-    } else {
-      alive.erase(std::remove_if(alive.begin(), alive.end(), [&](uint32_t k) { return !keep(k); }),
-                  alive.end());
+      if (misses <= allowed) {
+        hull.occupied[candidates_[k]] = 1;
+        ++occupied;
+      }
     }
   }
-  for (uint32_t k : alive) hull.occupied[candidates_[k]] = 1;
-  hull.occupied_count = static_cast<int>(alive.size());
+  hull.occupied_count = occupied;
+  return hull;
+}
+
+VoxelHull VoxelCarver::CarveReference(const std::vector<cv::Mat>& silhouettes) const {
+  const std::vector<cv::Mat> distance = DistanceTransforms(silhouettes);
+  VoxelHull hull = EmptyHull();
+  const size_t nc = cameras_.size();
+  for (size_t k = 0; k < candidates_.size(); ++k) {
+    int misses = 0;
+    for (size_t c = 0; c < nc; ++c) {
+      misses += !Passes(distance[c].ptr<float>(), cameras_[c].width, footprints_[k * nc + c]);
+    }
+    if (misses <= options_.max_missing_views) {
+      hull.occupied[candidates_[k]] = 1;
+      ++hull.occupied_count;
+    }
+  }
   return hull;
 }
 

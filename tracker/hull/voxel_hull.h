@@ -83,12 +83,24 @@ class VoxelCarver {
  public:
   // Throws InputError for bad options or no cameras. Cost: about two
   // projections per voxel and camera (0.6 s for 4 cameras and 2.5 cm voxels);
-  // memory: 8 bytes per observed voxel and camera.
+  // memory: 8 bytes per candidate voxel and camera plus 4 per candidate.
   VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& options = {});
 
   // `silhouettes[c]`: CV_8UC1 of camera c's size, > 127 is silhouette.
   // Throws InputError on a count or size mismatch.
+  //
+  // Coarse to fine: the candidates are grouped in blocks of kBlock^3 voxels,
+  // and the look-up table holds, per block and camera, a bound on the test
+  // values of all the block's voxels from the distance transform at one pixel
+  // (the transform is 1-Lipschitz). A block that more than max_missing_views
+  // cameras certainly carve is skipped; a camera that certainly keeps a block
+  // is not consulted for its voxels; only the rest go through the per-voxel
+  // test. The result is bit-identical to CarveReference().
   VoxelHull Carve(const std::vector<cv::Mat>& silhouettes) const;
+
+  // The same occupancy by the plain evaluation of every candidate voxel in
+  // every camera, without the block bounds: the reference for tests; slow.
+  VoxelHull CarveReference(const std::vector<cv::Mat>& silhouettes) const;
 
   const VoxelGridOptions& options() const { return options_; }
   const std::vector<Camera>& cameras() const { return cameras_; }
@@ -99,6 +111,9 @@ class VoxelCarver {
   size_t candidate_count() const { return candidates_.size(); }
 
  private:
+  // Edge of a block, in voxels.
+  static constexpr int kBlock = 8;
+
   // Per candidate voxel and camera: the index of the pixel at the floor of the
   // centre's projection x, the fractional part of x in 1/256 pixel, and the
   // radius in 1/64 pixel; pixel < 0: no constraint.
@@ -107,12 +122,30 @@ class VoxelCarver {
     uint8_t frac_u, frac_v;
     uint16_t radius_q;
   };
+  // Per block and camera, with D the camera's distance transform: every voxel
+  // of the block fails the test when D[pixel] > carve_above, and passes it
+  // when D[pixel] <= keep_below (carve_above = +inf, keep_below = -inf: no
+  // such certainty).
+  struct BlockBound {
+    int32_t pixel;
+    float carve_above, keep_below;
+  };
+  // The candidates [first, first + count) in candidates_ form one block.
+  struct Block {
+    uint32_t first, count;
+  };
+
+  // Distance transforms of the silhouettes (see Carve); throws InputError.
+  std::vector<cv::Mat> DistanceTransforms(const std::vector<cv::Mat>& silhouettes) const;
+  VoxelHull EmptyHull() const;
 
   std::vector<Camera> cameras_;
   VoxelGridOptions options_;
   int nx_ = 0, ny_ = 0, nz_ = 0;
-  std::vector<uint32_t> candidates_;   // voxel indices
-  std::vector<Footprint> footprints_;  // camera-major: [camera][candidate]
+  std::vector<uint32_t> candidates_;    // voxel indices, grouped by block
+  std::vector<Footprint> footprints_;   // candidate-major: [candidate][camera]
+  std::vector<Block> blocks_;           // the blocks holding candidates
+  std::vector<BlockBound> bounds_;      // [block][camera]
 };
 
 }  // namespace irbench

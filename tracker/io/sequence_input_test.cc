@@ -1,6 +1,7 @@
 #include "tracker/io/sequence_input.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -16,7 +17,8 @@ namespace fs = std::filesystem;
 class SequenceInputTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = irbench::testing::FreshTempDir("tracker_io");
+    // ctest runs each test in its own process, maybe at once: a folder per process.
+    dir_ = irbench::testing::FreshTempDir("tracker_io_" + std::to_string(::getpid()));
     RenderJobOptions options;
     options.rig = "lab4";
     options.frames = 3;
@@ -24,6 +26,7 @@ class SequenceInputTest : public ::testing::Test {
     options.out = dir_ / "seq";
     RunRenderJob(options);
   }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
   static fs::path dir_;
 };
 fs::path SequenceInputTest::dir_;
