@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
   track_cmd->add_flag("--overlays", track.overlays, "also write debug overlays (PNG, colour)");
   track_cmd->add_flag("--ply", track.ply, "also write the voxel and polyhedral hulls per frame as PLY");
   track_cmd->add_option("--hull-missing-views", track.hull_missing_views,
-                        "voxel hull: cameras allowed to disagree (0: the thesis's hull; 1 keeps what one view lost)")
+                        "voxel hull: cameras allowed to disagree, 0 or 1 (0: the thesis's hull; 1 keeps what one view lost)")
       ->capture_default_str();
   track_cmd->add_option("--frames", track_frames, "frames to process (default: all)");
   track_cmd->add_option("--out", track_out, "output folder (default: SEQ/track)");
@@ -114,12 +114,12 @@ int main(int argc, char** argv) {
 
   // demo
   irbench::DemoOptions demo;
-  std::string demo_out = demo.out.string();
+  std::string demo_out;
   int demo_frames = 0;
   CLI::App* demo_cmd = app.add_subcommand(
       "demo", "The main job: render the default session (theater4, thesis preset, about 20 s),\n"
               "run the tracker, score it against the truth, print the tables");
-  demo_cmd->add_option("--out", demo_out, "sequence folder (track/ and score/ go inside)")->capture_default_str();
+  demo_cmd->add_option("--out", demo_out, "sequence folder, track/ and score/ go inside (default: renders/demo)");
   demo_cmd->add_option("--avatar", demo.avatar, "avatar name (avatars/) or file")->capture_default_str();
   demo_cmd->add_option("--motion", demo.motion, "motion, as for render --motion")->capture_default_str();
   demo_cmd->add_option("--sensor", demo.sensor, "sensor preset: clean, thesis or harsh")->capture_default_str();

@@ -308,6 +308,43 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
   }
   for (const char* name : {"t2", "t3"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
+  // An output that would replace the sequence or land in what it reads.
+  for (const auto& [out, expected] : {std::pair<fs::path, std::string>{dir / "seq", "would replace the sequence"},
+                                      {dir, "would replace the sequence"},
+                                      {dir / "seq" / "frames" / "x", "inside the sequence's frames/"}}) {
+    const Result bad = RunIrbench({"track", (dir / "seq").string(), "--out", out.string(), "--force"}, dir);
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
+  }
+  EXPECT_TRUE(fs::exists(dir / "seq" / "manifest.json"));
+
+  // An empty stage (the empty-stage frames given as the frames): state "empty",
+  // the root null.
+  fs::copy(dir / "seq", dir / "empty", fs::copy_options::recursive);
+  fs::remove_all(dir / "empty" / "track");
+  for (const auto& cam : fs::directory_iterator(dir / "empty" / "frames")) {
+    const std::string name = cam.path().filename().string();
+    for (const char* frame : {"000000.png", "000001.png"}) {
+      fs::copy_file(dir / "empty" / "background" / name / "000000.png", cam.path() / frame,
+                    fs::copy_options::overwrite_existing);
+    }
+  }
+  ASSERT_EQ(RunIrbench({"track", (dir / "empty").string()}, dir).exit_code, 0);
+  std::ifstream empty_lines(dir / "empty" / "track" / "track.jsonl");
+  int empty_count = 0;
+  for (std::string l; std::getline(empty_lines, l); ++empty_count) {
+    const auto j = nlohmann::json::parse(l);
+    EXPECT_EQ(j["state"], "empty");
+    EXPECT_TRUE(j["joints3d"]["root"].is_null());
+  }
+  EXPECT_EQ(empty_count, 2);
+  // And the person's sequence is tracked with a root.
+  std::ifstream seq_lines(track / "track.jsonl");
+  for (std::string l; std::getline(seq_lines, l);) {
+    const auto j = nlohmann::json::parse(l);
+    EXPECT_EQ(j["state"], "tracking");
+    EXPECT_TRUE(j["joints3d"]["root"].is_array());
+  }
 }
 
 TEST(CliTest, ScorePrintsTheTablesAndRefusesBadInput) {

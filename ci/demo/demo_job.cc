@@ -2,6 +2,7 @@
 
 #include "ci/score/score.h"
 #include "common/logging.h"
+#include "common/paths.h"
 #include "sim/sequence/render_job.h"
 #include "tracker/frontend/track_job.h"
 
@@ -16,7 +17,7 @@ DemoResult RunDemo(const DemoOptions& options) {
   render.frames = options.frames;
   render.seed = options.seed;
   render.background_frames = 12;
-  render.out = options.out;
+  render.out = options.out.empty() ? DataRoot() / "renders" / "demo" : options.out;
   render.overwrite = options.overwrite;
   Log().info("demo: 1/3 render ({} on theater4, {} preset)", options.avatar, options.sensor);
   DemoResult result;

@@ -11,7 +11,7 @@
 namespace irbench {
 
 struct DemoOptions {
-  std::filesystem::path out = "renders/demo";  // the sequence folder; track/ and score/ go inside
+  std::filesystem::path out;  // the sequence folder (default: <data root>/renders/demo); track/, score/ inside
   std::string avatar = "p1";
   std::string motion = "demo";
   std::string sensor = "thesis";

@@ -57,6 +57,31 @@ std::optional<Eigen::Vector3d> Point(const Json& parent, const std::string& key,
   return Eigen::Vector3d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
 }
 
+std::string LineField(const Json& line, const std::string& key) {
+  return "line " + std::to_string(line.value("_line", 0)) + ": " + key;
+}
+
+// A boolean field: nullopt when absent or null; InputError for another type.
+std::optional<bool> Flag(const Json& parent, const std::string& key, const fs::path& file,
+                         const Json& line) {
+  if (!parent.is_object() || !parent.contains(key) || parent[key].is_null()) return std::nullopt;
+  if (!parent[key].is_boolean()) throw InputError(file.string(), LineField(line, key), "expected true, false or null");
+  return parent[key].get<bool>();
+}
+std::optional<bool> Flag(const Json& line, const std::string& key, const fs::path& file) {
+  return Flag(line, key, file, line);
+}
+
+// "tracking" (also when absent) or "empty"; InputError otherwise.
+std::string TrackState(const Json& line, const fs::path& file) {
+  if (!line.contains("state")) return "tracking";
+  const Json& s = line["state"];
+  if (!s.is_string() || (s != "tracking" && s != "empty")) {
+    throw InputError(file.string(), LineField(line, "state"), "expected \"tracking\" or \"empty\"");
+  }
+  return s;
+}
+
 const Json* Child(const Json& j, const std::string& key) {
   return j.is_object() && j.contains(key) && !j[key].is_null() ? &j[key] : nullptr;
 }
@@ -65,6 +90,14 @@ std::string Fixed(double v, int digits) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
   return buf;
+}
+
+// A CSV number, empty when nothing was scored.
+std::string Csv(int total, double v) {
+  if (total == 0) return "";
+  std::ostringstream out;
+  out << v;
+  return out.str();
 }
 
 std::string Title(const std::string& joint) {
@@ -141,11 +174,11 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
   std::map<std::string, std::vector<int>> joint_frames, pointing_frames;
   std::map<std::string, int> joint_missing, pointing_missing;
   for (const auto& [frame, truth] : truth_by_frame) {
-    if (!truth.value("present", false)) continue;
+    if (!Flag(truth, "present", truth_jsonl).value_or(false)) continue;
     ++score.present_frames;
     const auto it = track_by_frame.find(frame);
     const Json* track = it == track_by_frame.end() ? nullptr : &it->second;
-    const bool tracking = track && track->value("state", "tracking") == "tracking";
+    const bool tracking = track && TrackState(*track, track_jsonl) == "tracking";
     score.tracked_frames += tracking;
     const Json* truth_joints = Child(truth, "joints3d");
     const Json* track_joints = tracking ? Child(*track, "joints3d") : nullptr;
@@ -158,7 +191,7 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       if (!options.include_rest_arms && truth_rest && (joint.find("elbow") != std::string::npos ||
                                                        joint.find("wrist") != std::string::npos)) {
         const std::string side = joint.rfind("left", 0) == 0 ? "left" : "right";
-        if (truth_rest->value(side, false)) continue;
+        if (Flag(*truth_rest, side, truth_jsonl, truth).value_or(false)) continue;
       }
       const auto p = track_joints ? Point(*track_joints, joint, track_jsonl, *track) : std::nullopt;
       if (!p) {
@@ -240,8 +273,10 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
 
 nlohmann::json Score::ToJson() const {
   auto stats = [](const ErrorStats& s) {
-    return Json{{"mean", s.mean}, {"std", s.std}, {"outliers", s.outliers}, {"total", s.total},
-                {"missing", s.missing}, {"max", s.max}};
+    // Nothing scored: null, never a perfect 0.
+    const auto value = [&](double v) { return s.total ? Json(v) : Json(nullptr); };
+    return Json{{"mean", value(s.mean)}, {"std", value(s.std)}, {"outliers", s.outliers}, {"total", s.total},
+                {"missing", s.missing}, {"max", value(s.max)}};
   };
   Json j;
   j["format"] = "irbench.score/1";
@@ -338,13 +373,13 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary) {
   joints_csv << "joint,mean_cm,std_cm,outliers,total,missing,max_cm\n";
   for (const std::string& joint : ScoredJoints()) {
     const ErrorStats& s = score.joints.at(joint);
-    joints_csv << joint << "," << s.mean << "," << s.std << "," << s.outliers << "," << s.total << "," << s.missing
-               << "," << s.max << "\n";
+    joints_csv << joint << "," << Csv(s.total, s.mean) << "," << Csv(s.total, s.std) << "," << s.outliers << ","
+               << s.total << "," << s.missing << "," << Csv(s.total, s.max) << "\n";
   }
   for (const std::string side : {"right", "left"}) {
     const ErrorStats& s = score.pointing.at(side);
-    joints_csv << "pointing_" << side << "_deg," << s.mean << "," << s.std << "," << s.outliers << "," << s.total
-               << "," << s.missing << "," << s.max << "\n";
+    joints_csv << "pointing_" << side << "_deg," << Csv(s.total, s.mean) << "," << Csv(s.total, s.std) << ","
+               << s.outliers << "," << s.total << "," << s.missing << "," << Csv(s.total, s.max) << "\n";
   }
   AtomicWriteFile(staging.path() / "joints.csv", joints_csv.str());
   std::ostringstream errors_csv;

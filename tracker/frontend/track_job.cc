@@ -63,6 +63,7 @@ cv::Mat Overlay(const cv::Mat& frame, const CameraFeatures& f, const AxisView* v
       const Eigen::Vector3d p_in_cam = view->camera.cam_from_world * a.p_in_world;
       if (p_in_cam.z() <= 0) continue;
       const Eigen::Vector2d px = view->camera.Project(a.p_in_world);
+      if (!px.allFinite() || px.cwiseAbs().maxCoeff() > 1e5) continue;
       cv::drawMarker(out, cv::Point(int(std::lround(px.x())), int(std::lround(px.y()))), {255, 255, 255},
                      cv::MARKER_CROSS, 3, 1);
     }
@@ -92,11 +93,29 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", "--background-model", e.what());
   }
-  if (options.hull_missing_views < 0 || options.hull_missing_views > 2) {
-    throw InputError("", "--hull-missing-views", "must be 0, 1 or 2");
+  if (options.hull_missing_views < 0 || options.hull_missing_views > 1) {
+    throw InputError("", "--hull-missing-views", "must be 0 or 1");
   }
   fe_options.voxels.max_missing_views = options.hull_missing_views;
-  fe_options.Check();
+  try {
+    fe_options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", "track options", e.what());
+  }
+  // The output must not replace or sit inside what it reads.
+  {
+    const fs::path seq = fs::weakly_canonical(fs::absolute(options.sequence));
+    const fs::path out_abs = fs::weakly_canonical(fs::absolute(options.out.empty() ? options.sequence / "track"
+                                                                                    : options.out));
+    auto inside = [](const fs::path& child, const fs::path& parent) {
+      const auto rel = child.lexically_relative(parent);
+      return !rel.empty() && *rel.begin() != "..";
+    };
+    if (inside(seq, out_abs)) throw InputError("", "--out", "would replace the sequence folder itself");
+    for (const char* part : {"frames", "background", "calib", "truth"}) {
+      if (inside(out_abs, seq / part)) throw InputError("", "--out", std::string("lies inside the sequence's ") + part + "/");
+    }
+  }
   const SequenceInput input = SequenceInput::Open(options.sequence);
   int frames = input.frame_count();
   if (options.frames) {
@@ -181,7 +200,8 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     track_line["state"] = features.placement ? "tracking" : "empty";
     nlohmann::json joints = nlohmann::json::object();
     for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
-                             "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip"}) {
+                             "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
+                             "left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle"}) {
       joints[name] = nullptr;
     }
     if (features.placement) {

@@ -35,7 +35,7 @@ struct TrackJobOptions {
   bool remove_shadows = true;
   bool overlays = false;
   bool ply = false;
-  int hull_missing_views = 0;  // voxel hull: views allowed to disagree (0: the thesis's hull)  // voxel hull (cubes) and polyhedral hull per frame as PLY
+  int hull_missing_views = 0;  // voxel hull: cameras allowed to disagree (0: the thesis's hull; 1)  // voxel hull (cubes) and polyhedral hull per frame as PLY
   std::optional<int> frames;  // default: all
   bool overwrite = false;
 };

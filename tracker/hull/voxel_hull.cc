@@ -25,6 +25,11 @@ void VoxelGridOptions::Check() const {
   if (footprint_scale < 0 || footprint_scale > 4)
     throw InputError("", "footprint_scale", "must be in [0, 4]");
   if (min_observing_cameras < 1) throw InputError("", "min_observing_cameras", "must be >= 1");
+  if (max_missing_views >= min_observing_cameras) {
+    // Else a voxel seen by just min_observing_cameras cameras could never be carved.
+    throw InputError("", "max_missing_views", "must be below min_observing_cameras (" +
+                                                  std::to_string(min_observing_cameras) + ")");
+  }
   if (!(near_m > 0)) throw InputError("", "near_m", "must be > 0");
 }
 

@@ -1,5 +1,6 @@
 #include "tracker/io/sequence_input.h"
 
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/error.h"
@@ -22,13 +23,38 @@ int CountNumbered(const fs::path& folder) {
 cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std::string& key, int rows,
                    int cols) {
   cv::Mat m;
-  fs[key] >> m;
+  try {
+    const cv::FileNode node = fs[key];
+    if (node.empty() || node.isNone()) throw InputError(file, key, "missing");
+    if (!node.isMap()) throw InputError(file, key, "not an opencv-matrix");
+    node >> m;
+  } catch (const cv::Exception& e) {
+    throw InputError(file, key, "not an opencv-matrix: " + e.msg);
+  }
   if (m.empty()) throw InputError(file, key, "missing");
   if (m.rows * m.cols != rows * cols) {
     throw InputError(file, key, "expected " + std::to_string(rows) + "x" + std::to_string(cols) + " values");
   }
   m.convertTo(m, CV_64F);
+  if (!cv::checkRange(m)) throw InputError(file, key, "holds a NaN or an infinity");
   return m.reshape(1, rows);
+}
+
+// Frames are numbered from 0 without gaps: a gap with later frames behind it
+// is an error, not the end of the sequence.
+void CheckNoGap(const fs::path& folder, int count) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() != 10 || entry.path().extension() != ".png") continue;
+    const std::string stem = name.substr(0, 6);
+    if (stem.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (std::stoi(stem) > count) {
+      char missing[32];
+      std::snprintf(missing, sizeof(missing), "%06d.png", count);
+      throw InputError(folder.string(), "", std::string(missing) + " is missing while later frames exist");
+    }
+  }
 }
 
 // calib/screens.json (irbench.screens/1): the geometry and the targets'
@@ -97,7 +123,11 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
   if (!intri.isOpened()) throw InputError(intri_file.string(), "", "unreadable");
   if (!extri.isOpened()) throw InputError(extri_file.string(), "", "unreadable");
   std::vector<std::string> names;
-  intri["names"] >> names;
+  try {
+    intri["names"] >> names;
+  } catch (const cv::Exception& e) {
+    throw InputError(intri_file.string(), "names", "expected a list of camera names: " + e.msg);
+  }
   if (names.empty()) throw InputError(intri_file.string(), "names", "missing or empty");
   const JsonNode cameras_json = ParseJsonFile(cameras_file.string());
   const JsonNode list = cameras_json["cameras"];
@@ -107,6 +137,7 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
     const cv::Mat k = ReadMatrix(intri, intri_file.string(), "K_" + name, 3, 3);
     cam.fx = k.at<double>(0, 0), cam.fy = k.at<double>(1, 1);
     cam.cx = k.at<double>(0, 2), cam.cy = k.at<double>(1, 2);
+    if (!(cam.fx > 0 && cam.fy > 0)) throw InputError(intri_file.string(), "K_" + name, "focal lengths must be > 0");
     const cv::Mat dist = ReadMatrix(intri, intri_file.string(), "dist_" + name, 1, 5);
     for (int i = 0; i < 5; ++i) cam.dist[i] = dist.at<double>(0, i);
     const cv::Mat rot = ReadMatrix(extri, extri_file.string(), "Rot_" + name, 3, 3);
@@ -114,14 +145,20 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
     Eigen::Matrix3d r;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) r(a, b) = rot.at<double>(a, b);
+    if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || r.determinant() < 0) {
+      throw InputError(extri_file.string(), "Rot_" + name, "not a rotation (orthonormal, determinant +1)");
+    }
     cam.cam_from_world.linear() = r;
     cam.cam_from_world.translation() = Eigen::Vector3d(t.at<double>(0), t.at<double>(1), t.at<double>(2));
     bool found = false;
     for (size_t i = 0; i < list.Size(); ++i) {
       if (list[i].GetString("name") != name) continue;
+      const std::string field = "cameras[" + std::to_string(i) + "]";
       cam.width = list[i].GetInt("width");
       cam.height = list[i].GetInt("height");
-      cam.fps = list[i].GetDouble("fps", 30.0);
+      if (cam.width <= 0 || cam.height <= 0) list[i]["width"].Fail("image size must be positive");
+      cam.fps = list[i].GetDouble("fps");
+      if (!(cam.fps > 0 && std::isfinite(cam.fps))) list[i]["fps"].Fail("must be > 0");
       cam.exposure_ms = list[i].GetDouble("exposure_ms", cam.exposure_ms);
       found = true;
     }
@@ -133,6 +170,8 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
   for (size_t c = 0; c < in.cameras_.size(); ++c) {
     const int frames = CountNumbered(dir / "frames" / in.cameras_[c].name);
     const int backgrounds = CountNumbered(dir / "background" / in.cameras_[c].name);
+    CheckNoGap(dir / "frames" / in.cameras_[c].name, frames);
+    CheckNoGap(dir / "background" / in.cameras_[c].name, backgrounds);
     if (frames == 0) {
       throw InputError((dir / "frames" / in.cameras_[c].name).string(), "", "no frames (000000.png, ...)");
     }

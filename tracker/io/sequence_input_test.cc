@@ -74,6 +74,33 @@ TEST_F(SequenceInputTest, BadFoldersNameTheFile) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("'" + first_cam + "' has 2 and 2"), std::string::npos) << e.what();
   }
+  // A gap with later frames behind it is not the end of the sequence.
+  fs::copy_file(bad / "frames" / first_cam / "000001.png", bad / "frames" / first_cam / "000002.png");
+  fs::remove(bad / "frames" / first_cam / "000001.png");
+  try {
+    SequenceInput::Open(bad);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("000001.png is missing while later frames exist"), std::string::npos)
+        << e.what();
+  }
+  // A calibration rotation that is not one.
+  {
+    const fs::path skew = dir_ / "skew";
+    fs::remove_all(skew);
+    fs::copy(dir_ / "seq", skew, fs::copy_options::recursive);
+    std::string extri = irbench::testing::ReadText(skew / "calib/extri.yml");
+    const size_t at = extri.find("Rot_" + first_cam);
+    const size_t data = extri.find_first_not_of(' ', extri.find("data: [", at) + 7);
+    extri.replace(data, extri.find(',', data) - data, "0.5");  // R(0,0) = 0.5: no longer orthonormal
+    irbench::testing::WriteText(skew / "calib/extri.yml", extri);
+    try {
+      SequenceInput::Open(skew);
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "Rot_" + first_cam) << e.what();
+    }
+  }
   std::ofstream(bad / "calib/extri.yml") << "%YAML:1.0\nnames: [a]\n";
   try {
     SequenceInput::Open(bad);

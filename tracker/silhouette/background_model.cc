@@ -15,7 +15,11 @@ void BackgroundOptions::Check() const {
   if (!(pool_sigma >= 0 && pool_threshold > 0)) {
     throw std::invalid_argument("background pool_sigma: must be >= 0, pool_threshold > 0");
   }
-  if (!(min_sigma >= 0)) throw std::invalid_argument("background min_sigma: must be >= 0");
+  if (!(pool_weak_threshold > 0 && pool_weak_threshold <= pool_threshold)) {
+    throw std::invalid_argument("background pool_weak_threshold: must be in (0, pool_threshold]");
+  }
+  // sigma 0 (a saturated or constant pixel) would make the normalised difference infinite.
+  if (!(min_sigma > 0)) throw std::invalid_argument("background min_sigma: must be > 0");
   if (open_radius < 0 || close_radius < 0) throw std::invalid_argument("background morphology radii: must be >= 0");
   if (!(min_blob_fraction >= 0 && min_blob_fraction < 1)) {
     throw std::invalid_argument("background min_blob_fraction: must be in [0, 1)");
