@@ -394,6 +394,11 @@ TEST(CliTest, DemoRendersTracksAndScores) {
                            "score/tables.md"}) {
     EXPECT_TRUE(fs::exists(dir / "demo" / file)) << file;
   }
+  // Only the root is tracked so far (and the first 8 frames see the person
+  // still entering): what was not scored is null, never a perfect 0.
+  const auto score = nlohmann::json::parse(ReadText(dir / "demo" / "score" / "score.json"));
+  EXPECT_TRUE(score["joints_cm"]["neck"]["mean"].is_null()) << score["joints_cm"]["neck"].dump();
+  EXPECT_EQ(score["joints_cm"]["neck"]["total"], 0);
   // Again without --force: refused, the first run kept.
   const Result again = RunIrbench({"demo", "--frames", "8", "--out", (dir / "demo").string()}, dir);
   EXPECT_EQ(again.exit_code, 2);

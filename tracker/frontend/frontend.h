@@ -30,7 +30,9 @@ struct FrontEndOptions {
   VoxelGridOptions voxels;  // voxel hull (thesis 4.2)
   bool carve_voxels = true;
   PolyhedralHullOptions polyhedral;  // polyhedral hull (thesis 4.1)
-  bool polyhedral_hull = true;
+  // Built on request (irbench track --ply): nothing downstream uses it yet and
+  // it is the front end's most expensive stage.
+  bool polyhedral_hull = false;
   void Check() const;  // throws std::invalid_argument
 };
 

@@ -97,6 +97,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     throw InputError("", "--hull-missing-views", "must be 0 or 1");
   }
   fe_options.voxels.max_missing_views = options.hull_missing_views;
+  fe_options.polyhedral_hull = options.ply;
   try {
     fe_options.Check();
   } catch (const std::invalid_argument& e) {
