@@ -16,6 +16,7 @@
 #include "sim/sequence/render_job.h"
 #include "ci/demo/demo_job.h"
 #include "ci/score/score.h"
+#include "ci/suite/suite.h"
 #include "tracker/frontend/track_job.h"
 
 namespace {
@@ -126,6 +127,19 @@ int main(int argc, char** argv) {
   demo_cmd->add_option("--frames", demo_frames, "frames to render (default: the whole session; fewer for a quick look)");
   demo_cmd->add_option("--seed", demo.seed, "seed for everything random")->capture_default_str();
   demo_cmd->add_flag("--force", demo.overwrite, "replace an existing output folder");
+
+  // suite
+  irbench::SuiteRunOptions suite;
+  std::string suite_name, suite_baselines, suite_cache;
+  CLI::App* suite_cmd = app.add_subcommand("suite", "Closed-loop accuracy regression: run a suite of scenarios");
+  suite_cmd->require_subcommand(1);
+  CLI::App* suite_run = suite_cmd->add_subcommand(
+      "run", "Render (cached), track and score every scenario of a suite; check thresholds and the\n"
+             "blessed baseline; print a pass/fail table; exit 1 on a regression");
+  suite_run->add_option("SUITE", suite_name, "suite name (ci/suites/) or file")->required();
+  suite_run->add_flag("--bless", suite.bless, "write this run's figures as the new baseline (on purpose)");
+  suite_run->add_option("--baselines", suite_baselines, "baseline folder (default: ci/baselines)");
+  suite_run->add_option("--cache", suite_cache, "render cache folder (default: renders/cache)");
 
   // score
   irbench::ScoreJobOptions score;
@@ -242,6 +256,20 @@ int main(int argc, char** argv) {
                 << "track     " << r.track.string() << "\n"
                 << "score     " << r.score.string() << "\n"
                 << "(the pose tracker is not built yet: joints other than the root are missing)\n";
+      return kExitOk;
+    }
+    if (suite_run->parsed()) {
+      suite.suite = suite_name;
+      suite.baselines = suite_baselines;
+      suite.cache = suite_cache;
+      const irbench::SuiteResult r = irbench::RunSuite(suite);
+      std::cout << "# suite " << r.name << (suite.bless ? " (blessed)" : "") << "\n" << r.Table();
+      if (!r.pass) {
+        int failed = 0;
+        for (const auto& row : r.rows) failed += !row.pass;
+        std::cerr << "error: suite " << r.name << ": " << failed << " metric(s) failed\n";
+        return kExitRuntime;
+      }
       return kExitOk;
     }
     if (score_cmd->parsed()) {

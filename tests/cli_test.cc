@@ -60,7 +60,7 @@ TEST(CliTest, HelpOnEveryCommand) {
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
         {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
         {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
-        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}}) {
+        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}, {"suite", "run", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
@@ -404,6 +404,37 @@ TEST(CliTest, DemoRendersTracksAndScores) {
   EXPECT_EQ(again.exit_code, 2);
   EXPECT_NE(again.err.find("exists"), std::string::npos) << again.err;
   EXPECT_TRUE(fs::exists(dir / "demo" / "score/score.json"));
+}
+
+// The smoke suite passes against the blessed baselines, and fails when the
+// tracker is deliberately degraded (the thesis's plain background model and no
+// shadow removal, under the same suite name and baselines).
+TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
+  const fs::path dir = FreshTempDir("cli_suite");
+  const fs::path smoke = fs::path(IRBENCH_SOURCE_DIR) / "ci" / "suites" / "smoke.json";
+  const Result ok = RunIrbench({"suite", "run", "smoke", "--cache", (dir / "cache").string()}, dir);
+  EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
+  EXPECT_NE(ok.out.find("| p1_flap_both | silhouette_iou_median |"), std::string::npos) << ok.out;
+  EXPECT_EQ(ok.out.find("FAIL"), std::string::npos) << ok.out;
+
+  auto degraded = nlohmann::json::parse(ReadText(smoke));
+  for (auto& scenario : degraded["scenarios"]) {
+    scenario["track"] = {{"background_model", "plain"}, {"remove_shadows", false}};
+  }
+  WriteText(dir / "degraded.json", degraded.dump(2));
+  const Result bad = RunIrbench({"suite", "run", (dir / "degraded.json").string(), "--cache", (dir / "cache").string(),
+                                 "--baselines", (fs::path(IRBENCH_SOURCE_DIR) / "ci" / "baselines").string()},
+                                dir);
+  EXPECT_EQ(bad.exit_code, 1) << bad.out << bad.err;
+  EXPECT_NE(bad.out.find("regressed from the baseline"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.err.find("suite smoke:"), std::string::npos) << bad.err;
+
+  // A bad suite file: one line naming the file and field, exit 2.
+  WriteText(dir / "typo.json", R"({"format": "irbench.suite/1", "name": "t", "scenarios": [
+    {"name": "a", "thresholds": {"silhouette_iou": {"min": 0.5}}}]})");
+  const Result typo = RunIrbench({"suite", "run", (dir / "typo.json").string(), "--cache", (dir / "cache").string()}, dir);
+  EXPECT_EQ(typo.exit_code, 2) << typo.err;
+  EXPECT_NE(typo.err.find("typo.json: scenarios[0].thresholds.silhouette_iou"), std::string::npos) << typo.err;
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

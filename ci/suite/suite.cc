@@ -1,0 +1,237 @@
+#include "ci/suite/suite.h"
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <fstream>
+#include <sstream>
+
+#include "ci/score/score.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/json_reader.h"
+#include "common/logging.h"
+#include "common/paths.h"
+#include "sim/sequence/render_job.h"
+#include "tracker/frontend/track_job.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+namespace {
+
+struct Bound {
+  std::string kind;  // "max" or "min"
+  double value = 0;
+  double tolerance = 0;  // allowed drift from the baseline, absolute
+};
+
+struct Scenario {
+  std::string name;
+  RenderJobOptions render;
+  std::string background_model = "flicker";
+  bool remove_shadows = true;
+  int hull_missing_views = 0;
+  std::map<std::string, Bound> thresholds;
+};
+
+const std::vector<std::string>& KnownMetrics() {
+  static const std::vector<std::string> m = {"silhouette_iou_median", "tracked_fraction", "root_mean_cm"};
+  return m;
+}
+
+std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
+  const JsonNode root = ParseJsonFile(file.string());
+  root.CheckKeys({"format", "name", "description", "scenarios"});
+  if (root.GetString("format") != "irbench.suite/1") root["format"].Fail("expected \"irbench.suite/1\"");
+  *name = root.GetString("name", file.stem().string());
+  std::vector<Scenario> out;
+  const JsonNode list = root["scenarios"];
+  if (list.Size() == 0) list.Fail("no scenarios");
+  for (size_t i = 0; i < list.Size(); ++i) {
+    const JsonNode s = list[i];
+    s.CheckKeys({"name", "scene", "rig", "avatar", "motion", "sensor", "seed", "frames", "background_frames",
+                 "track", "thresholds"});
+    Scenario sc;
+    sc.name = s.GetString("name");
+    for (const Scenario& other : out) {
+      if (other.name == sc.name) s["name"].Fail("'" + sc.name + "' appears twice");
+    }
+    sc.render.scene = s.GetString("scene", "");
+    sc.render.rig = s.GetString("rig", "theater4");
+    sc.render.avatar = s.GetString("avatar", "p1");
+    sc.render.motion = s.GetString("motion", "demo");
+    sc.render.sensor = s.GetString("sensor", "thesis");
+    sc.render.seed = static_cast<uint64_t>(s.GetInt("seed", 1));
+    if (s.Has("frames")) {
+      sc.render.frames = s.GetInt("frames");
+      if (*sc.render.frames < 1) s["frames"].Fail("must be at least 1");
+    }
+    sc.render.background_frames = s.GetInt("background_frames", 12);
+    if (sc.render.background_frames < 2) s["background_frames"].Fail("the tracker needs at least 2");
+    if (s.Has("track")) {
+      const JsonNode t = s["track"];
+      t.CheckKeys({"background_model", "remove_shadows", "hull_missing_views"});
+      sc.background_model = t.GetString("background_model", "flicker");
+      if (sc.background_model != "flicker" && sc.background_model != "plain") {
+        t["background_model"].Fail("must be flicker or plain");
+      }
+      sc.remove_shadows = t.Has("remove_shadows") ? t["remove_shadows"].raw().get<bool>() : true;
+      sc.hull_missing_views = t.GetInt("hull_missing_views", 0);
+    }
+    const JsonNode th = s["thresholds"];
+    for (const auto& [metric, value] : th.raw().items()) {
+      if (std::find(KnownMetrics().begin(), KnownMetrics().end(), metric) == KnownMetrics().end()) {
+        th[metric].Fail("unknown metric (silhouette_iou_median, tracked_fraction, root_mean_cm)");
+      }
+      const JsonNode b = th[metric];
+      b.CheckKeys({"max", "min", "tolerance"});
+      Bound bound;
+      if (b.Has("max") == b.Has("min")) b.Fail("give exactly one of max or min");
+      bound.kind = b.Has("max") ? "max" : "min";
+      bound.value = b.GetDouble(bound.kind);
+      bound.tolerance = b.GetDouble("tolerance", 0.0);
+      if (bound.tolerance < 0) b["tolerance"].Fail("must be >= 0");
+      sc.thresholds[metric] = bound;
+    }
+    out.push_back(sc);
+  }
+  return out;
+}
+
+std::string Number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.4g", v);
+  return buf;
+}
+
+// The render inputs that decide the frames, hashed with the tool version and
+// the contents of the files they name.
+std::string CacheKey(const RenderJobOptions& r) {
+  const RenderInputs in = LoadRenderInputs(r);  // validates, resolves names to files
+  std::string key = ToolVersion() + "|" + r.rig + "|" + r.scene + "|" + r.avatar + "|" + r.motion + "|" + r.sensor +
+                    "|" + std::to_string(r.seed) + "|" + std::to_string(r.frames.value_or(-1)) + "|" +
+                    std::to_string(r.background_frames) + "|" + std::to_string(r.supersample);
+  for (const fs::path& f : {in.rig_file, in.scene_file, in.avatar_file, in.motion_file}) {
+    if (f.empty() || !fs::is_regular_file(f)) continue;
+    std::ifstream file(f, std::ios::binary);
+    key += std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  }
+  char hex[20];
+  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(Fnv1a64(key)));
+  return hex;
+}
+
+double MedianSilhouetteIoU(const fs::path& seq, const fs::path& track) {
+  std::vector<double> ious;
+  for (const auto& cam : fs::directory_iterator(seq / "truth" / "masks")) {
+    for (const auto& f : fs::directory_iterator(cam.path())) {
+      const cv::Mat truth = cv::imread(f.path().string(), cv::IMREAD_GRAYSCALE);
+      const cv::Mat sil = cv::imread((track / "silhouettes" / cam.path().filename() / f.path().filename()).string(),
+                                     cv::IMREAD_GRAYSCALE);
+      if (truth.empty() || sil.empty() || cv::countNonZero(truth) == 0) continue;
+      const int u = cv::countNonZero(truth | sil);
+      ious.push_back(double(cv::countNonZero(truth & sil)) / u);
+    }
+  }
+  if (ious.empty()) return 0;
+  std::sort(ious.begin(), ious.end());
+  return ious[ious.size() / 2];
+}
+
+}  // namespace
+
+std::string SuiteResult::Table() const {
+  std::ostringstream out;
+  out << "| scenario | metric | value | threshold | baseline | result |\n|---|---|---|---|---|---|\n";
+  for (const MetricResult& r : rows) {
+    out << "| " << r.scenario << " | " << r.metric << " | " << Number(r.value) << " | " << r.bound << " | "
+        << r.baseline << " | " << (r.pass ? "pass" : "**FAIL**: " + r.why) << " |\n";
+  }
+  return out.str();
+}
+
+SuiteResult RunSuite(const SuiteRunOptions& options) {
+  fs::path file = options.suite;
+  if (!fs::is_regular_file(file)) file = ResolveDataFile("ci/suites", options.suite.string(), "SUITE");
+  SuiteResult result;
+  const std::vector<Scenario> scenarios = ReadSuite(file, &result.name);
+  const fs::path baselines_dir = options.baselines.empty() ? DataRoot() / "ci" / "baselines" : options.baselines;
+  const fs::path baseline_file = baselines_dir / (result.name + ".json");
+  nlohmann::json baseline = nlohmann::json::object();
+  if (fs::is_regular_file(baseline_file)) baseline = ParseJsonFile(baseline_file.string()).raw();
+  const fs::path cache = options.cache.empty() ? DataRoot() / "renders" / "cache" : options.cache;
+  fs::create_directories(cache);
+  nlohmann::json blessed = nlohmann::json::object();
+  for (size_t i = 0; i < scenarios.size(); ++i) {
+    const Scenario& sc = scenarios[i];
+    Log().info("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), sc.name);
+    // Render, or reuse the cached frames of the same inputs.
+    RenderJobOptions render = sc.render;
+    const fs::path seq = cache / (sc.name + "-" + CacheKey(render));
+    if (!fs::is_regular_file(seq / "manifest.json")) {
+      render.out = seq;
+      render.overwrite = true;
+      RunRenderJob(render);
+    } else {
+      Log().info("suite {}: {} rendered before (cache {})", result.name, sc.name, seq.filename().string());
+    }
+    TrackJobOptions track;
+    track.sequence = seq;
+    track.out = seq / ("track-" + sc.background_model + (sc.remove_shadows ? "" : "-shadows") + "-h" +
+                       std::to_string(sc.hull_missing_views));
+    track.background_model = sc.background_model;
+    track.remove_shadows = sc.remove_shadows;
+    track.hull_missing_views = sc.hull_missing_views;
+    track.overwrite = true;
+    RunTrackJob(track);
+    const Score score = ScoreTrack(seq / "truth" / "frames.jsonl", track.out / "track.jsonl");
+    std::map<std::string, double> metrics;
+    metrics["silhouette_iou_median"] = MedianSilhouetteIoU(seq, track.out);
+    metrics["tracked_fraction"] =
+        score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
+    const ErrorStats& root = score.joints.at("root");
+    if (root.total > 0) metrics["root_mean_cm"] = root.mean;
+    for (const auto& [metric, bound] : sc.thresholds) {
+      MetricResult r;
+      r.scenario = sc.name;
+      r.metric = metric;
+      r.bound = bound.kind + " " + Number(bound.value);
+      const auto it = metrics.find(metric);
+      if (it == metrics.end()) {
+        r.pass = false;
+        r.why = "not measured (nothing scored)";
+        result.rows.push_back(r);
+        continue;
+      }
+      r.value = it->second;
+      blessed[sc.name][metric] = r.value;
+      const bool higher_better = bound.kind == "min";
+      if (higher_better ? r.value < bound.value : r.value > bound.value) {
+        r.pass = false;
+        r.why = "beyond the threshold";
+      }
+      if (baseline.contains(sc.name) && baseline[sc.name].contains(metric) && baseline[sc.name][metric].is_number()) {
+        const double base = baseline[sc.name][metric];
+        r.baseline = Number(base) + " ± " + Number(bound.tolerance);
+        const bool worse = higher_better ? r.value < base - bound.tolerance : r.value > base + bound.tolerance;
+        if (worse && !options.bless) {
+          r.pass = false;
+          r.why = r.why.empty() ? "regressed from the baseline" : r.why + "; regressed from the baseline";
+        }
+      } else {
+        r.baseline = "none";
+      }
+      result.rows.push_back(r);
+    }
+  }
+  for (const MetricResult& r : result.rows) result.pass &= r.pass;
+  if (options.bless) {
+    fs::create_directories(baselines_dir);
+    AtomicWriteFile(baseline_file, blessed.dump(2) + "\n");
+    Log().info("suite {}: baseline written to {}", result.name, baseline_file.string());
+  }
+  return result;
+}
+
+}  // namespace irbench

@@ -1,0 +1,51 @@
+#pragma once
+// `irbench suite run`: closed-loop accuracy regression (issue 8). A suite file
+// (ci/suites/<name>.json, irbench.suite/1) lists scenarios — scene, rig,
+// person, motion, sensor preset, seed, frames, tracker options — with
+// per-metric thresholds. Each scenario is rendered (cached by a hash of its
+// render inputs and the tool version, under renders/cache/), tracked and
+// scored; its metrics are checked against the thresholds and against the
+// blessed baseline (ci/baselines/<name>.json) within the metric's tolerance.
+// `--bless` writes the baseline from this run on purpose.
+//
+// Metrics (all from the tracker's output against the truth; more as the
+// tracker grows):
+//   silhouette_iou_median   median over camera-frames of the silhouettes' IoU
+//                           with the truth masks (higher is better)
+//   tracked_fraction        frames tracked / frames with the person on stage
+//   root_mean_cm            root error mean, Chauvenet outliers removed
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace irbench {
+
+struct SuiteRunOptions {
+  std::filesystem::path suite;      // file or name in ci/suites/
+  std::filesystem::path baselines;  // default: <data root>/ci/baselines
+  std::filesystem::path cache;      // default: <data root>/renders/cache
+  bool bless = false;
+};
+
+struct MetricResult {
+  std::string scenario, metric;
+  double value = 0;
+  std::string bound;     // "max 15" / "min 0.7" / ""
+  std::string baseline;  // "12.1 ± 1.2" / "none"
+  bool pass = true;
+  std::string why;  // when it fails
+};
+
+struct SuiteResult {
+  std::string name;
+  std::vector<MetricResult> rows;
+  bool pass = true;
+  std::string Table() const;  // Markdown
+};
+
+// Throws InputError for a bad suite file (naming the file and field).
+SuiteResult RunSuite(const SuiteRunOptions& options);
+
+}  // namespace irbench
