@@ -134,11 +134,12 @@ std::vector<bool> ChauvenetOutliers(const std::vector<double>& samples) {
   return out;
 }
 
-ErrorStats Summarise(const std::vector<double>& errors, int missing) {
+ErrorStats Summarise(const std::vector<double>& errors, int missing, std::vector<bool>* outliers) {
   ErrorStats s;
   s.total = static_cast<int>(errors.size());
   s.missing = missing;
   const std::vector<bool> outlier = ChauvenetOutliers(errors);
+  if (outliers) *outliers = outlier;
   std::vector<double> kept;
   for (size_t i = 0; i < errors.size(); ++i) {
     if (outlier[i]) {
@@ -254,19 +255,20 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       score.motion.correct += label == truth_label;
     }
   }
+  // One Chauvenet pass per series gives both the summary and the per-frame flags.
+  auto summarise = [](const std::vector<double>& errors, const std::vector<int>& frames, int missing,
+                      ErrorStats* stats, std::vector<std::tuple<int, double, bool>>* rows) {
+    std::vector<bool> out;
+    *stats = Summarise(errors, missing, &out);
+    for (size_t i = 0; i < errors.size(); ++i) rows->emplace_back(frames[i], errors[i], out[i]);
+  };
   for (const std::string& joint : ScoredJoints()) {
-    score.joints[joint] = Summarise(joint_errors[joint], joint_missing[joint]);
-    const std::vector<bool> out = ChauvenetOutliers(joint_errors[joint]);
-    for (size_t i = 0; i < joint_errors[joint].size(); ++i) {
-      score.joint_errors[joint].emplace_back(joint_frames[joint][i], joint_errors[joint][i], out[i]);
-    }
+    summarise(joint_errors[joint], joint_frames[joint], joint_missing[joint], &score.joints[joint],
+              &score.joint_errors[joint]);
   }
   for (const std::string side : {"right", "left"}) {
-    score.pointing[side] = Summarise(pointing_errors[side], pointing_missing[side]);
-    const std::vector<bool> out = ChauvenetOutliers(pointing_errors[side]);
-    for (size_t i = 0; i < pointing_errors[side].size(); ++i) {
-      score.pointing_errors[side].emplace_back(pointing_frames[side][i], pointing_errors[side][i], out[i]);
-    }
+    summarise(pointing_errors[side], pointing_frames[side], pointing_missing[side], &score.pointing[side],
+              &score.pointing_errors[side]);
   }
   return score;
 }

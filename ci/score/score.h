@@ -35,8 +35,9 @@ struct ErrorStats {
   double max = 0;            // largest error kept
 };
 
-// Mean, std, outliers and total of `errors` (Chauvenet applied).
-ErrorStats Summarise(const std::vector<double>& errors, int missing);
+// Mean, std, outliers and total of `errors` (Chauvenet applied); the flags
+// per sample go to `outliers` when given.
+ErrorStats Summarise(const std::vector<double>& errors, int missing, std::vector<bool>* outliers = nullptr);
 
 struct ScoreOptions {
   bool include_rest_arms = false;  // score elbows and wrists of arms at rest too
