@@ -17,7 +17,7 @@
 #include "ci/demo/demo_job.h"
 #include "ci/score/score.h"
 #include "ci/suite/suite.h"
-#include "tracker/frontend/track_job.h"
+#include "tracker/pipeline/track_job.h"
 
 namespace {
 
@@ -98,8 +98,12 @@ int main(int argc, char** argv) {
       "track", "Run the tracker on a sequence folder (frames, calibration and empty-stage frames only)");
   track_cmd->add_option("SEQ", track_sequence, "sequence folder written by render")->required();
   track_cmd->add_option("--stage", track.stage,
-                        "how far to go: features (silhouettes; more stages arrive with the tracker)")
+                        "how far to go: pose (front end + particle-filter pose, joints and pointing) or\n"
+                        "features (silhouettes, axis points, hull only)")
       ->capture_default_str();
+  track_cmd->add_option("--particles", track.particles, "pose: particles of the filter (thesis 6.3)")
+      ->capture_default_str();
+  track_cmd->add_option("--seed", track.seed, "pose: seed of the filter's random stream")->capture_default_str();
   track_cmd->add_option("--background-model", track.background_model,
                         "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)")
       ->capture_default_str();

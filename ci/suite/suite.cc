@@ -14,7 +14,7 @@
 #include "common/logging.h"
 #include "common/paths.h"
 #include "sim/sequence/render_job.h"
-#include "tracker/frontend/track_job.h"
+#include "tracker/pipeline/track_job.h"
 
 namespace irbench {
 namespace fs = std::filesystem;

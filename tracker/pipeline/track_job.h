@@ -2,17 +2,19 @@
 // `irbench track SEQ --stage features`: runs the front end over a sequence and
 // writes what it found, for inspection and for the later stages.
 //
-//   <out>/track.jsonl              the tracker output (docs/formats.md): state
-//                                  (empty/tracking, from the voxel hull), the
-//                                  root from the hull; the rest null until the
-//                                  pose tracker lands
+//   <out>/track.jsonl              the tracker output (docs/formats.md): state,
+//                                  joints3d, the 21 dof, pointing rays with
+//                                  screen hits (stage "pose", the default); with
+//                                  --stage features only the state and the
+//                                  root from the voxel hull
 //   <out>/features.jsonl           a line per frame: per camera the silhouette's
 //                                  area, the light level, blobs removed; ms per stage
 //   <out>/silhouettes/<cam>/NNNNNN.png   255 person, 0 else
 //   <out>/overlays/<cam>/NNNNNN.png      (--overlays) the frame with the
 //                                  silhouette outline (green), the pixels
 //                                  shadow removal took away (red), axis points
-//                                  by part, 3D axis points projected (white)
+//                                  by part, 3D axis points projected (white),
+//                                  the tracked ellipsoid model (orange)
 //   <out>/hull/NNNNNN_voxels.ply, NNNNNN_polyhedral.ply   (--ply) the voxel
 //                                  hull as cubes and the polyhedral hull, world
 //                                  metres, z up (MeshLab, Blender)
@@ -30,12 +32,14 @@ namespace irbench {
 struct TrackJobOptions {
   std::filesystem::path sequence;
   std::filesystem::path out;  // default: <sequence>/track
-  std::string stage = "features";
+  std::string stage = "pose";  // or "features" (front end only)
+  int particles = 100;         // pose: particles of the filter (thesis 6.3)
+  uint64_t seed = 1;           // pose: the filter's random stream
   std::string background_model = "flicker";  // or "plain" (thesis 3.1)
   bool remove_shadows = true;
   bool overlays = false;
   bool ply = false;
-  int hull_missing_views = 0;  // voxel hull: cameras allowed to disagree (0: the thesis's hull; 1)  // voxel hull (cubes) and polyhedral hull per frame as PLY
+  int hull_missing_views = 0;  // voxel hull: cameras allowed to disagree (0: the thesis's hull; 1)
   std::optional<int> frames;  // default: all
   bool overwrite = false;
 };

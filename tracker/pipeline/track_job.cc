@@ -1,4 +1,4 @@
-#include "tracker/frontend/track_job.h"
+#include "tracker/pipeline/track_job.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,7 +12,9 @@
 #include "common/cancel.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "tracker/frontend/frontend.h"
 #include "tracker/hull/ply.h"
+#include "tracker/pose/pose_tracker.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -38,6 +40,24 @@ cv::Scalar PartColour(BodyPart part) {
     case BodyPart::kRightImageArm: return {230, 230, 0};  // cyan
     case BodyPart::kArm: return {230, 230, 0};
     default: return {140, 140, 140};
+  }
+}
+
+// The model's ellipse outlines, from ideal pixels to the camera's distorted
+// image.
+void DrawModel(cv::Mat* out, const Camera& camera, const PosedBody& body) {
+  const auto P = ProjectionMatrix(camera);
+  const Eigen::Matrix3d K_inv = camera.K().inverse();
+  for (const ImageEllipse& e : ProjectBody(camera, P, body)) {
+    std::vector<Eigen::Vector2d> ideal;
+    e.Contour(48, &ideal, nullptr);
+    std::vector<cv::Point> poly;
+    for (const Eigen::Vector2d& p : ideal) {
+      const Eigen::Vector3d n = K_inv * p.homogeneous();
+      const Eigen::Vector2d d = camera.Distort(n.head<2>() / n.z());
+      poly.emplace_back(int(std::lround(camera.fx * d.x() + camera.cx)), int(std::lround(camera.fy * d.y() + camera.cy)));
+    }
+    cv::polylines(*out, poly, true, cv::Scalar(0, 140, 255), 1, cv::LINE_AA);
   }
 }
 
@@ -82,9 +102,10 @@ const char* Part3dName(BodyPart part) {
 }  // namespace
 
 fs::path RunTrackJob(const TrackJobOptions& options) {
-  if (options.stage != "features") {
-    throw InputError("", "--stage", "'" + options.stage + "' is not built yet; available: features");
+  if (options.stage != "features" && options.stage != "pose") {
+    throw InputError("", "--stage", "'" + options.stage + "': expected features or pose");
   }
+  if (options.particles < 1) throw InputError("", "--particles", "must be at least 1");
   FrontEndOptions fe_options;
   fe_options.background.model = options.background_model;
   fe_options.remove_shadows = options.remove_shadows;
@@ -138,6 +159,13 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   Log().info("track: background models for {} cameras from {} empty-stage frames in {:.0f} ms",
              input.cameras().size(), input.background_count(), train_ms);
 
+  std::optional<PoseTracker> pose_tracker;
+  if (options.stage == "pose") {
+    PoseTrackerOptions pose_options;
+    pose_options.particles = options.particles;
+    pose_options.seed = options.seed;
+    pose_tracker.emplace(input.cameras(), input.screens(), pose_options);
+  }
   std::string lines, track_lines;
   const auto start = std::chrono::steady_clock::now();
   auto last_report = start;
@@ -146,6 +174,8 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     std::vector<cv::Mat> images;
     for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
     const FrameFeatures features = front_end.Process(f, images);
+    std::optional<PoseEstimate> pose;
+    if (pose_tracker) pose = pose_tracker->Step(features, 1.0 / input.fps());
     nlohmann::json line;
     line["frame"] = f;
     line["t"] = f / input.fps();
@@ -171,7 +201,9 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
       WritePng(root / "silhouettes" / name / FrameName(f), cf.silhouette);
       if (options.overlays) {
         const AxisView* view = c < features.views.size() ? &features.views[c] : nullptr;
-        WritePng(root / "overlays" / name / FrameName(f), Overlay(images[c], cf, view, features.axis3d));
+        cv::Mat overlay = Overlay(images[c], cf, view, features.axis3d);
+        if (pose && pose->tracking) DrawModel(&overlay, input.cameras()[c], pose->body);
+        WritePng(root / "overlays" / name / FrameName(f), overlay);
       }
     }
     nlohmann::json axis3d = nlohmann::json::array();
@@ -198,24 +230,61 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     nlohmann::json track_line;
     track_line["frame"] = f;
     track_line["t"] = f / input.fps();
-    track_line["state"] = features.placement ? "tracking" : "empty";
+    const bool tracking = pose ? pose->tracking : features.placement.has_value();
+    track_line["state"] = tracking ? "tracking" : "empty";
+    auto rounded = [](const Eigen::Vector3d& p) {
+      return nlohmann::json{std::round(p.x() * 1e4) / 1e4, std::round(p.y() * 1e4) / 1e4,
+                            std::round(p.z() * 1e4) / 1e4};
+    };
     nlohmann::json joints = nlohmann::json::object();
     for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
                              "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
                              "left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle"}) {
       joints[name] = nullptr;
     }
-    if (features.placement) {
+    for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
+    track_line["height_m"] = nullptr;
+    if (pose && pose->tracking) {
+      for (int j = 0; j < kModelJointCount; ++j) joints[ModelJointName(j)] = rounded(pose->body.joints[j]);
+      nlohmann::json dof = nlohmann::json::object();
+      for (int d = 0; d < kDofCount; ++d) dof[BodyDofName(d)] = std::round(pose->pose.dof[d] * 1e5) / 1e5;
+      track_line["dof"] = dof;
+      nlohmann::json pointing = nlohmann::json::object();
+      for (int side = 0; side < 2; ++side) {
+        const auto& ray = pose->pointing[side];
+        nlohmann::json j = nullptr;
+        if (ray) {
+          j = {{"origin", rounded(ray->origin)}, {"dir", rounded(ray->dir)}, {"screen", nullptr},
+               {"screen_hit", nullptr}, {"target", nullptr}};
+          if (ray->screen_hit) {
+            j["screen"] = *ray->screen;
+            j["screen_hit"] = {std::round(ray->screen_hit->x() * 1e4) / 1e4, std::round(ray->screen_hit->y() * 1e4) / 1e4};
+            if (ray->target) j["target"] = *ray->target;
+          }
+        }
+        pointing[side == 0 ? "right" : "left"] = j;
+      }
+      track_line["pointing"] = pointing;
+      track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
+      nlohmann::json overlap = nlohmann::json::object();
+      for (size_t c = 0; c < pose->overlap.size(); ++c) {
+        overlap[input.cameras()[c].name] = std::round(pose->overlap[c] * 1e4) / 1e4;
+      }
+      line["pose_overlap"] = overlap;
+    } else if (!pose && features.placement) {
       const Eigen::Vector3d& r = features.placement->root;
       joints["root"] = {std::round(r.x() * 1e4) / 1e4, std::round(r.y() * 1e4) / 1e4, 0.0};
+      track_line["height_m"] = std::round(features.placement->top_m * 1e3) / 1e3;
     }
     track_line["joints3d"] = joints;
-    track_line["height_m"] = features.placement ? nlohmann::json(std::round(features.placement->top_m * 1e3) / 1e3)
-                                                : nlohmann::json(nullptr);
-    for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
     line["ms"] = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes},
                   {"polygons", features.ms_polygons},       {"voxels", features.ms_voxels},
                   {"polyhedral_hull", features.ms_polyhedral}};
+    if (pose) {
+      line["ms"]["pose"] = pose->ms_total;
+      line["ms"]["pose_observation"] = pose->ms_observation;
+      line["ms"]["pose_refine"] = pose->ms_refine;
+    }
     if (options.ply) {
       char stem[32];
       std::snprintf(stem, sizeof(stem), "%06d", f);
@@ -236,6 +305,8 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   nlohmann::json meta = {{"format", "irbench.track-features/1"},
                          {"sequence", fs::absolute(options.sequence).lexically_normal().string()},
                          {"stage", options.stage},
+                         {"particles", options.particles},
+                         {"seed", options.seed},
                          {"background_model", options.background_model},
                          {"remove_shadows", options.remove_shadows},
                          {"hull_missing_views", options.hull_missing_views},

@@ -1,0 +1,215 @@
+// Unit tests of the pose stage's parts on silhouettes rasterised from the
+// ellipsoid model itself (the closed loop on rendered skinned avatars is
+// tests/pose_closed_loop_test.cc).
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "sim/camera/rig.h"
+#include "tracker/pose/icp.h"
+#include "tracker/pose/observation.h"
+#include "tracker/pose/pointing.h"
+#include "tracker/pose/pose_tracker.h"
+
+namespace irbench {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+std::vector<Camera> PinholeRig() {
+  std::vector<Camera> cams = LoadRig(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json").cameras;
+  for (Camera& c : cams) c.dist = {};  // model silhouettes are drawn in ideal pixels
+  return cams;
+}
+
+double Iou(const cv::Mat& a, const cv::Mat& b) {
+  const int inter = cv::countNonZero(a & b), uni = cv::countNonZero(a | b);
+  return uni ? static_cast<double>(inter) / uni : 0.0;
+}
+
+TEST(Observation, OverlapRatioEqualsTheRasterisedIou) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    BodyPose truth = ScarecrowPose(shape, Vector2d(0.3 * u(rng), 0.3 * u(rng)), u(rng));
+    BodyPose guess = truth;
+    guess.dof[kDofX] += 0.1 * u(rng);
+    guess.dof[kDofRightShoulderZenith] += 0.8 * u(rng);
+    const Camera& cam = cams[trial % cams.size()];
+    const auto P = ProjectionMatrix(cam);
+    const cv::Size size(cam.width, cam.height);
+    const cv::Mat silhouette = RasteriseEllipses(ProjectBody(cam, P, PoseBody(shape, truth)), size);
+    const std::vector<ImageEllipse> model = ProjectBody(cam, P, PoseBody(shape, guess));
+    cv::Mat map1, map2;
+    MakeUndistortMaps(cam, &map1, &map2);
+    const SilhouetteView full(cam, silhouette, map1, map2, 1.0);
+    EXPECT_NEAR(full.OverlapRatio(model), Iou(silhouette, RasteriseEllipses(model, size)), 1e-12);
+    // Half resolution: the ellipses scaled about the pixel grid against the
+    // area-downsampled silhouette.
+    const SilhouetteView half(cam, silhouette, map1, map2, 0.5);
+    std::vector<ImageEllipse> model_half;
+    for (const ImageEllipse& e : model) model_half.push_back(e.Scaled(0.5));
+    EXPECT_NEAR(half.OverlapRatio(model), Iou(half.level(), RasteriseEllipses(model_half, half.level().size())),
+                1e-12);
+  }
+}
+
+TEST(Icp, QuaternionAverageAlignsSignsFirst) {
+  const Eigen::Quaterniond a(Eigen::AngleAxisd(0.2, Vector3d::UnitZ()));
+  const Eigen::Quaterniond b(Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
+  Eigen::Quaterniond minus_b = b;
+  minus_b.coeffs() = -b.coeffs();
+  const Eigen::AngleAxisd mean(AverageQuaternions({a, minus_b}));
+  EXPECT_NEAR(mean.angle(), 0.4, 1e-12);
+  EXPECT_GT(mean.axis().dot(Vector3d::UnitZ()), 1 - 1e-12);
+}
+
+std::vector<IcpView> ModelViews(const std::vector<Camera>& cams, const BodyShape& shape, const BodyPose& truth) {
+  std::vector<IcpView> views;
+  for (const Camera& cam : cams) {
+    const auto P = ProjectionMatrix(cam);
+    const cv::Mat s = RasteriseEllipses(ProjectBody(cam, P, PoseBody(shape, truth)), cv::Size(cam.width, cam.height));
+    views.push_back({cam, P, OutlinePolygons(s)});
+  }
+  return views;
+}
+
+double ArmAngleDeg(const BodyShape& shape, const BodyPose& a, const BodyPose& b, int from, int to) {
+  const PosedBody pa = PoseBody(shape, a), pb = PoseBody(shape, b);
+  const Vector3d da = (pa.joints[to] - pa.joints[from]).normalized();
+  const Vector3d db = (pb.joints[to] - pb.joints[from]).normalized();
+  return std::acos(std::clamp(da.dot(db), -1.0, 1.0)) * 180 / M_PI;
+}
+
+TEST(Icp, PullsAPerturbedArmAndBodyBackTowardsTheOutlines) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  BodyPose truth = ScarecrowPose(shape, Vector2d(0.1, -0.2), 0.3);
+  truth.dof[kDofRightShoulderAzimuth] = 0.6;  // forward and out
+  truth.dof[kDofRightElbowZenith] = 0.5;
+  const std::vector<IcpView> views = ModelViews(cams, shape, truth);
+  BodyPose start = truth;
+  start.dof[kDofRightShoulderZenith] -= 0.30;  // 17 deg lower
+  start.dof[kDofLeftShoulderZenith] += 0.25;
+  start.dof[kDofX] += 0.05;
+  IcpOptions options;
+  options.iterations = 3;
+  const BodyPose refined = RefineIcp(shape, start, views, options);
+  const double before = ArmAngleDeg(shape, start, truth, kModelRightShoulder, kModelRightElbow);
+  const double after = ArmAngleDeg(shape, refined, truth, kModelRightShoulder, kModelRightElbow);
+  EXPECT_LT(after, 0.35 * before) << before << " -> " << after;
+  const double left_before = ArmAngleDeg(shape, start, truth, kModelLeftShoulder, kModelLeftElbow);
+  const double left_after = ArmAngleDeg(shape, refined, truth, kModelLeftShoulder, kModelLeftElbow);
+  EXPECT_LT(left_after, 0.35 * left_before) << left_before << " -> " << left_after;
+  EXPECT_LT(std::abs(refined.dof[kDofX] - truth.dof[kDofX]), 0.02);
+}
+
+// Synthetic frame features from the model itself: silhouettes, the hull's
+// placement and 3D arm axis points along the true arms.
+FrameFeatures ModelFeatures(const std::vector<Camera>& cams, const BodyShape& shape, const BodyPose& truth, int frame) {
+  FrameFeatures f;
+  f.frame = frame;
+  const PosedBody body = PoseBody(shape, truth);
+  for (const Camera& cam : cams) {
+    CameraFeatures cf;
+    cf.silhouette = RasteriseEllipses(ProjectBody(cam, ProjectionMatrix(cam), body), cv::Size(cam.width, cam.height));
+    f.cameras.push_back(cf);
+  }
+  BodyPlacement place;
+  place.root = body.joints[kModelRoot];
+  place.top_m = shape.height_m;
+  place.volume_m3 = 0.07;
+  f.placement = place;
+  for (int tip : {kModelRightHandTip, kModelLeftHandTip}) {
+    const Vector3d shoulder = body.joints[tip - 3], elbow = body.joints[tip - 2], hand = body.joints[tip];
+    for (double t = 0.2; t <= 1.0; t += 0.2) {
+      AxisPoint3d a;
+      a.part = BodyPart::kArm;
+      a.p_in_world = shoulder + t * (elbow - shoulder);
+      f.axis3d.push_back(a);
+      a.p_in_world = elbow + t * (hand - elbow);
+      f.axis3d.push_back(a);
+    }
+  }
+  return f;
+}
+
+double WorstJointError(const PosedBody& a, const PosedBody& b) {
+  double worst = 0;
+  for (int j = 0; j < kModelJointCount; ++j) worst = std::max(worst, (a.joints[j] - b.joints[j]).norm());
+  return worst;
+}
+
+TEST(PoseTracker, FollowsAModelRaisingItsArmAndRecoversFromScattering) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTrackerOptions options;
+  options.seed = 4;
+  PoseTracker tracker(cams, {}, options);
+  std::vector<double> errors;
+  BodyPose truth = StandingPose(shape, Vector2d(0.2, 0.1), 0.0);
+  PoseEstimate e;
+  for (int f = 0; f < 30; ++f) {
+    truth.dof[kDofRightShoulderAzimuth] = M_PI / 2;                        // forward
+    truth.dof[kDofRightShoulderZenith] = 0.15 + (M_PI / 2 - 0.15) * f / 20.0;  // raising to horizontal
+    if (f > 20) truth.dof[kDofRightShoulderZenith] = M_PI / 2;
+    truth.dof[kDofX] = 0.2 + 0.005 * f;
+    e = tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30);
+    ASSERT_TRUE(e.tracking) << f;
+    if (f >= 5) errors.push_back(WorstJointError(e.body, PoseBody(shape, truth)));
+  }
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.05) << "median worst-joint error";
+
+  // Scattered particles (thesis 6.6: recovery in 2-3 frames).
+  tracker.Scatter();
+  int recovered_after = -1;
+  for (int f = 0; f < 6 && recovered_after < 0; ++f) {
+    e = tracker.Step(ModelFeatures(cams, shape, truth, 30 + f), 1.0 / 30);
+    if (e.tracking && (e.body.joints[kModelRoot] - PoseBody(shape, truth).joints[kModelRoot]).norm() < 0.05) {
+      recovered_after = f + 1;
+    }
+  }
+  EXPECT_GE(recovered_after, 1);
+  EXPECT_LE(recovered_after, 3);
+
+  // An empty stage: no placement, no tracking.
+  FrameFeatures empty = ModelFeatures(cams, shape, truth, 40);
+  empty.placement.reset();
+  EXPECT_FALSE(tracker.Step(empty, 1.0 / 30).tracking);
+}
+
+TEST(Pointing, RayFromHeadThroughHandTipHitsTheNearestScreen) {
+  ScreenSurface near_screen, far_screen;
+  near_screen.name = "near";
+  near_screen.origin = Vector3d(-2, 3, 0);  // the plane y = 3
+  near_screen.right = Vector3d(1, 0, 0);
+  near_screen.up = Vector3d(0, 0, 1);
+  near_screen.width = 4;
+  near_screen.height = 3;
+  near_screen.targets["door"] = Vector2d(2.5, 1.6);
+  far_screen = near_screen;
+  far_screen.name = "far";
+  far_screen.origin = Vector3d(-2, 5, 0);
+  const Vector3d head(0, 0, 1.6);
+  const Vector3d hand(0.1, 0.6, 1.6);
+  auto ray = Pointing(head, hand, {far_screen, near_screen});
+  ASSERT_TRUE(ray);
+  EXPECT_NEAR(ray->dir.dot((hand - head).normalized()), 1.0, 1e-12);
+  // The planes' fronts (right x up = -y) face the viewer; the hit is on the
+  // nearer one, at the analytic point.
+  ASSERT_TRUE(ray->screen);
+  EXPECT_EQ(*ray->screen, "near");
+  const Vector3d hit = head + (3.0 / ray->dir.y()) * ray->dir;
+  EXPECT_NEAR(ray->screen_hit->x(), hit.x() + 2, 1e-9);
+  EXPECT_NEAR(ray->screen_hit->y(), hit.z(), 1e-9);
+  EXPECT_EQ(ray->target.value_or(""), "door");
+  EXPECT_FALSE(Pointing(head, head, {near_screen}));
+}
+
+}  // namespace
+}  // namespace irbench

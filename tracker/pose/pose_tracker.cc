@@ -1,0 +1,434 @@
+#include "tracker/pose/pose_tracker.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace irbench {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+double WrapAngle(double a) {
+  a = std::fmod(a + M_PI, 2 * M_PI);
+  if (a < 0) a += 2 * M_PI;
+  return a - M_PI;
+}
+
+bool IsAngleDof(int d) { return d >= kDofYaw; }
+
+double Millis(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+void PoseTrackerOptions::Check() const {
+  if (particles < 1) throw std::invalid_argument("pose.particles must be at least 1");
+  observation.Check();
+  icp.Check();
+  for (double p : {p_random_walk, p_body_position, p_arm_direction, p_default_pose}) {
+    if (!(p >= 0)) throw std::invalid_argument("pose proposal probabilities must be non-negative");
+  }
+  if (!(p_random_walk + p_body_position + p_arm_direction + p_default_pose > 0)) {
+    throw std::invalid_argument("pose proposal probabilities must not all be zero");
+  }
+  for (double s : {sigma_position_m, sigma_yaw_rad, sigma_torso_rad, sigma_arm_rad, max_step_rad, max_step_m}) {
+    if (!(s >= 0)) throw std::invalid_argument("pose noise and caps must be non-negative");
+  }
+  if (!(velocity_damping >= 0 && velocity_damping <= 1)) {
+    throw std::invalid_argument("pose.velocity_damping must be in [0, 1]");
+  }
+  if (!(refine_fraction >= 0 && refine_fraction <= 1)) {
+    throw std::invalid_argument("pose.refine_fraction must be in [0, 1]");
+  }
+  if (!(min_overlap >= 0 && min_overlap <= 1)) throw std::invalid_argument("pose.min_overlap must be in [0, 1]");
+  if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
+}
+
+PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface> screens,
+                         const PoseTrackerOptions& options)
+    : cameras_(std::move(cameras)), screens_(std::move(screens)), options_(options), rng_(options.seed) {
+  options_.Check();
+  for (const Camera& cam : cameras_) {
+    projections_.push_back(ProjectionMatrix(cam));
+    cv::Mat m1, m2;
+    MakeUndistortMaps(cam, &m1, &m2);
+    map1_.push_back(m1);
+    map2_.push_back(m2);
+  }
+  // Users face the screen (thesis 1.2): the mean of the screens' centres.
+  Vector2d sum = Vector2d::Zero();
+  for (const ScreenSurface& s : screens_) sum += s.PointAt(s.Size() / 2).head<2>();
+  if (!screens_.empty() && sum.norm() > 1e-6) facing_xy_ = (sum / screens_.size()).normalized();
+}
+
+double PoseTracker::Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views,
+                             std::vector<double>* overlaps) const {
+  const PosedBody body = PoseBody(shape_, pose);
+  double log_likelihood = 0;
+  if (overlaps) overlaps->assign(cameras_.size(), 0.0);
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    const double r = views[c].OverlapRatio(ProjectBody(cameras_[c], projections_[c], body));
+    if (overlaps) (*overlaps)[c] = r;
+    log_likelihood += options_.observation.sharpness * std::log(std::max(r, 0.01));
+  }
+  return log_likelihood;
+}
+
+namespace {
+
+// Places the body so that its root lands on `root_xy`.
+void PlaceRoot(const BodyShape& shape, BodyPose* pose, const Vector2d& root_xy) {
+  const PosedBody body = PoseBody(shape, *pose);
+  const Vector2d offset = root_xy - body.joints[kModelRoot].head<2>();
+  pose->dof[kDofX] += offset.x();
+  pose->dof[kDofY] += offset.y();
+}
+
+double YawFacing(const Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
+
+}  // namespace
+
+void PoseTracker::Initialise(const FrameFeatures& features) {
+  const BodyPlacement& place = *features.placement;
+  heights_ = {place.top_m};
+  shape_ = BodyShape::FromHeight(std::clamp(place.top_m, 1.2, 2.2));
+  const Vector2d root = place.root.head<2>();
+  Vector2d to_screen = facing_xy_;
+  std::normal_distribution<double> yaw_noise(0.0, 0.3), pos_noise(0.0, 0.03);
+  particles_.clear();
+  // Half face the screen; half face the stage's centre, where a user who
+  // has just walked in is heading.
+  const Vector2d to_centre = -root;
+  const double yaw_centre = to_centre.norm() > 0.5 ? YawFacing(to_centre.normalized()) : YawFacing(to_screen);
+  for (int i = 0; i < options_.particles; ++i) {
+    const double yaw = (i % 4 < 2 ? YawFacing(to_screen) : yaw_centre) + yaw_noise(rng_);
+    BodyPose p = (i % 2 == 0) ? StandingPose(shape_, root, yaw) : ScarecrowPose(shape_, root, yaw);
+    p.dof[kDofX] += pos_noise(rng_);
+    p.dof[kDofY] += pos_noise(rng_);
+    particles_.push_back(p);
+  }
+  previous_ = particles_;
+}
+
+void PoseTracker::Scatter() {
+  std::uniform_real_distribution<double> pos(-1.5, 1.5), yaw(-M_PI, M_PI), zen(0.0, 2.5), az(-M_PI, M_PI);
+  for (BodyPose& p : particles_) {
+    p = StandingPose(shape_, Vector2d(pos(rng_), pos(rng_)), yaw(rng_));
+    for (int sh : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
+      p.dof[sh] = az(rng_);
+      p.dof[sh + 1] = zen(rng_);
+    }
+    ClampToJointLimits(&p);
+  }
+  previous_ = particles_;
+}
+
+namespace {
+
+// The 3D arm axis points split into chains (single linkage within
+// `link_m`); each chain belongs to the shoulder nearest its nearest point, so
+// an arm reaching across the body stays with the shoulder it starts from.
+std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<AxisPoint3d>& axis3d,
+                                                     const Vector3d& right_shoulder, const Vector3d& left_shoulder,
+                                                     double link_m = 0.08) {
+  std::vector<Vector3d> points;
+  for (const AxisPoint3d& a : axis3d) {
+    if (a.part == BodyPart::kArm) points.push_back(a.p_in_world);
+  }
+  const int n = static_cast<int>(points.size());
+  std::vector<int> chain(n, -1);
+  int chains = 0;
+  for (int seed = 0; seed < n; ++seed) {
+    if (chain[seed] >= 0) continue;
+    std::vector<int> stack = {seed};
+    chain[seed] = chains;
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      for (int j = 0; j < n; ++j) {
+        if (chain[j] < 0 && (points[i] - points[j]).norm() < link_m) {
+          chain[j] = chains;
+          stack.push_back(j);
+        }
+      }
+    }
+    ++chains;
+  }
+  std::array<std::vector<Vector3d>, 2> out;
+  for (int c = 0; c < chains; ++c) {
+    double best_right = 1e9, best_left = 1e9;
+    for (int i = 0; i < n; ++i) {
+      if (chain[i] != c) continue;
+      best_right = std::min(best_right, (points[i] - right_shoulder).norm());
+      best_left = std::min(best_left, (points[i] - left_shoulder).norm());
+    }
+    const int side = best_right <= best_left ? 0 : 1;
+    for (int i = 0; i < n; ++i) {
+      if (chain[i] == c) out[side].push_back(points[i]);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& features) {
+  const PosedBody body = PoseBody(shape_, pose);
+  std::normal_distribution<double> jitter(0.0, 0.05);
+  const auto by_side = ArmPointsBySide(features.axis3d, body.frames[kRightUpperArm].translation(),
+                                       body.frames[kLeftUpperArm].translation());
+  for (int arm : {kRightUpperArm, kLeftUpperArm}) {
+    const Vector3d shoulder = body.frames[arm].translation();
+    const std::vector<Vector3d>& points = by_side[arm == kRightUpperArm ? 0 : 1];
+    std::vector<Vector3d> upper_points;
+    std::optional<Vector3d> farthest;
+    double farthest_d = 0.15;
+    for (const Vector3d& p : points) {
+      const double d = (p - shoulder).norm();
+      if (d > farthest_d) {
+        farthest_d = d;
+        farthest = p;
+      }
+      if (d > 0.06 && d < shape_.upper_arm_m) upper_points.push_back(p);
+    }
+    Vector3d upper, fore;
+    if (!farthest) {
+      // No arm seen apart from the body: most likely hanging at rest.
+      const Eigen::Matrix3d world_from_upper = body.frames[kUpperBody].linear();
+      const double side = arm == kRightUpperArm ? 1.0 : -1.0;
+      upper = fore = (world_from_upper * Vector3d(0.15 * side, 0.0, -1.0)).normalized();
+    } else {
+      const double reach = shape_.upper_arm_m + shape_.forearm_m + 0.5 * shape_.hand_m;
+      upper = fore = (*farthest - shoulder).normalized();
+      if (farthest_d < 0.9 * reach && !upper_points.empty()) {
+        std::uniform_int_distribution<size_t> pick(0, upper_points.size() - 1);
+        upper = (upper_points[pick(rng_)] - shoulder).normalized();
+        const Vector3d elbow = shoulder + shape_.upper_arm_m * upper;
+        if ((*farthest - elbow).norm() > 0.05) fore = (*farthest - elbow).normalized();
+      }
+    }
+    const Vector3d noise_u(jitter(rng_), jitter(rng_), jitter(rng_));
+    const Vector3d noise_f(jitter(rng_), jitter(rng_), jitter(rng_));
+    SetArmDirections(shape_, &pose, arm, (upper + noise_u).normalized(), (fore + noise_f).normalized());
+  }
+  return pose;
+}
+
+BodyPose PoseTracker::DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features) {
+  std::uniform_int_distribution<int> which(0, 3);
+  const Vector2d root = features.placement->root.head<2>();
+  const double yaw = current.dof[kDofYaw];
+  BodyPose p;
+  switch (which(rng_)) {
+    case 0:
+      p = StandingPose(shape_, root, yaw);
+      break;
+    case 1:
+      p = ScarecrowPose(shape_, root, yaw);
+      break;
+    default: {  // pointing forward with one arm, the other hanging
+      p = StandingPose(shape_, root, yaw);
+      const int sh = which(rng_) % 2 == 0 ? kDofRightShoulderAzimuth : kDofLeftShoulderAzimuth;
+      p.dof[sh] = M_PI / 2;
+      p.dof[sh + 1] = M_PI / 2;
+    }
+  }
+  return p;
+}
+
+BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous, const FrameFeatures& features,
+                              double dt) {
+  const double total = options_.p_random_walk + options_.p_body_position + options_.p_arm_direction +
+                       options_.p_default_pose;
+  std::uniform_real_distribution<double> u(0.0, total);
+  const double choice = u(rng_);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const double k = std::sqrt(std::max(dt, 1e-3) * 30.0);
+  BodyPose next = current;
+  if (choice < options_.p_random_walk) {
+    // Random walk with velocity (thesis 6.3.2), capped.
+    for (int d = 0; d < kDofCount; ++d) {
+      double v = current.dof[d] - previous.dof[d];
+      if (IsAngleDof(d)) v = WrapAngle(v);
+      const double cap = d < kDofYaw ? options_.max_step_m : options_.max_step_rad;
+      next.dof[d] += options_.velocity_damping * std::clamp(v, -cap, cap);
+    }
+    next.dof[kDofX] += k * options_.sigma_position_m * n01(rng_);
+    next.dof[kDofY] += k * options_.sigma_position_m * n01(rng_);
+    next.dof[kDofZ] += 0.3 * k * options_.sigma_position_m * n01(rng_);
+    next.dof[kDofYaw] += k * options_.sigma_yaw_rad * n01(rng_);
+    next.dof[kDofPitch] += 0.3 * k * options_.sigma_torso_rad * n01(rng_);
+    next.dof[kDofRoll] += 0.3 * k * options_.sigma_torso_rad * n01(rng_);
+    for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) {
+      next.dof[d] += k * options_.sigma_torso_rad * n01(rng_);
+    }
+    for (int d : {kDofRightShoulderAzimuth, kDofRightShoulderZenith, kDofLeftShoulderAzimuth, kDofLeftShoulderZenith,
+                  kDofRightElbowAzimuth, kDofRightElbowZenith, kDofLeftElbowAzimuth, kDofLeftElbowZenith}) {
+      next.dof[d] += k * options_.sigma_arm_rad * n01(rng_);
+    }
+    next.dof[kDofRightShoulderTwist] = next.dof[kDofLeftShoulderTwist] = 0.0;
+  } else if (choice < options_.p_random_walk + options_.p_body_position) {
+    // Body position from the voxel hull (thesis 6.3.2); while the user walks,
+    // the heading from the hull's motion (people face where they walk).
+    if (walking_) next.dof[kDofYaw] = YawFacing(velocity_xy_.normalized()) + 0.1 * n01(rng_);
+    PlaceRoot(shape_, &next, features.placement->root.head<2>() +
+                                 Vector2d(0.02 * n01(rng_), 0.02 * n01(rng_)));
+  } else if (choice < options_.p_random_walk + options_.p_body_position + options_.p_arm_direction) {
+    next = ArmDirectionProposal(current, features);
+  } else {
+    next = DefaultPoseProposal(current, features);
+  }
+  ClampToJointLimits(&next);
+  return next;
+}
+
+PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
+  const auto start = std::chrono::steady_clock::now();
+  PoseEstimate out;
+  if (!features.placement || features.cameras.size() != cameras_.size()) {
+    active_ = false;
+    out.ms_total = Millis(start);
+    return out;
+  }
+  std::vector<SilhouetteView> views;
+  std::vector<IcpView> icp_views;
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    views.emplace_back(cameras_[c], features.cameras[c].silhouette, map1_[c], map2_[c], options_.observation.scale);
+    if (options_.refine_fraction > 0) {
+      icp_views.push_back({cameras_[c], projections_[c], OutlinePolygons(views.back().ideal_silhouette())});
+    }
+  }
+
+  // The hull's ground velocity, smoothed: a walking user's heading.
+  const Vector2d root_xy = features.placement->root.head<2>();
+  if (active_ && dt > 0) {
+    velocity_xy_ = 0.6 * velocity_xy_ + 0.4 * (root_xy - last_root_xy_) / dt;
+  } else {
+    velocity_xy_.setZero();
+  }
+  last_root_xy_ = root_xy;
+  walking_ = velocity_xy_.norm() > options_.walking_speed_mps;
+
+  std::vector<BodyPose> proposed;
+  if (!active_) {
+    Initialise(features);
+    active_ = true;
+    proposed = particles_;
+  } else {
+    for (size_t i = 0; i < particles_.size(); ++i) {
+      proposed.push_back(Propose(particles_[i], previous_[i], features, dt));
+    }
+  }
+  if (hook_) {
+    // Posture-recognition proposals replace the last particles.
+    std::vector<BodyPose> extra = hook_(features, shape_);
+    for (size_t i = 0; i < extra.size() && i < proposed.size(); ++i) {
+      proposed[proposed.size() - 1 - i] = extra[i];
+    }
+  }
+
+  const int n = static_cast<int>(proposed.size());
+  std::vector<double> log_likelihood(n);
+  const auto t_obs = std::chrono::steady_clock::now();
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) log_likelihood[i] = Evaluate(proposed[i], views, nullptr);
+  });
+  out.ms_observation = Millis(t_obs);
+
+  // Refine-prediction (thesis 6.3.3): 2D-3D ICP on a random subset; a refined
+  // particle replaces its original when it explains the silhouettes better.
+  const auto t_refine = std::chrono::steady_clock::now();
+  const int refine = static_cast<int>(std::round(options_.refine_fraction * n));
+  if (refine > 0 && options_.icp.iterations > 0) {
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng_);
+    order.resize(refine);
+    std::vector<BodyPose> refined(refine);
+    std::vector<double> refined_ll(refine);
+    cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
+      for (int j = r.start; j < r.end; ++j) {
+        refined[j] = RefineIcp(shape_, proposed[order[j]], icp_views, options_.icp);
+        refined_ll[j] = Evaluate(refined[j], views, nullptr);
+      }
+    });
+    for (int j = 0; j < refine; ++j) {
+      if (refined_ll[j] > log_likelihood[order[j]]) {
+        proposed[order[j]] = refined[j];
+        log_likelihood[order[j]] = refined_ll[j];
+      }
+    }
+  }
+  out.ms_refine = Millis(t_refine);
+
+  const int best = static_cast<int>(std::max_element(log_likelihood.begin(), log_likelihood.end()) -
+                                    log_likelihood.begin());
+  out.log_likelihood = Evaluate(proposed[best], views, &out.overlap);
+  const double mean_overlap = std::accumulate(out.overlap.begin(), out.overlap.end(), 0.0) / out.overlap.size();
+  out.tracking = mean_overlap >= options_.min_overlap;
+  out.pose = proposed[best];
+
+  // Height (thesis 6.1.2): configured when the user enters, from the hull's
+  // top while the arms are below the shoulders; the particles keep their
+  // angles and move their waist heights with the scale.
+  {
+    const PosedBody body = PoseBody(shape_, out.pose);
+    const bool arms_low = body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
+                          body.joints[kModelLeftHandTip].z() < body.joints[kModelLeftShoulder].z();
+    if (out.tracking && arms_low && static_cast<int>(heights_.size()) < options_.height_frames) {
+      heights_.push_back(features.placement->top_m);
+      const double height = std::clamp(Median(heights_), 1.2, 2.2);
+      const double ratio = height / shape_.height_m;
+      shape_ = BodyShape::FromHeight(height);
+      for (BodyPose& p : proposed) p.dof[kDofZ] *= ratio;
+      for (BodyPose& p : particles_) p.dof[kDofZ] *= ratio;
+      out.pose.dof[kDofZ] *= ratio;
+    }
+  }
+  out.shape = shape_;
+  out.body = PoseBody(shape_, out.pose);
+  if (out.tracking) {
+    out.pointing[0] = Pointing(out.body.joints[kModelHead], out.body.joints[kModelRightHandTip], screens_);
+    out.pointing[1] = Pointing(out.body.joints[kModelHead], out.body.joints[kModelLeftHandTip], screens_);
+  }
+
+  // Resampling (systematic), carrying each particle's previous state along
+  // for the velocity.
+  const double max_ll = log_likelihood[best];
+  std::vector<double> cumulative(n);
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    sum += std::exp(log_likelihood[i] - max_ll);
+    cumulative[i] = sum;
+  }
+  std::uniform_real_distribution<double> u0(0.0, sum / n);
+  double pointer = u0(rng_);
+  std::vector<BodyPose> next(n), next_previous(n);
+  const std::vector<BodyPose>& before = particles_;
+  int i = 0;
+  for (int j = 0; j < n; ++j) {
+    while (i < n - 1 && cumulative[i] < pointer) ++i;
+    next[j] = proposed[i];
+    next_previous[j] = i < static_cast<int>(before.size()) ? before[i] : proposed[i];
+    pointer += sum / n;
+  }
+  particles_ = std::move(next);
+  previous_ = std::move(next_previous);
+  out.ms_total = Millis(start);
+  return out;
+}
+
+}  // namespace irbench

@@ -1,0 +1,117 @@
+#pragma once
+// Pose tracking (thesis 6.3, 6.5): a particle filter over the 21-DOF ellipsoid
+// body whose observation is the silhouette overlap of every camera
+// (observation.h), with the thesis's proposal functions — a random walk with
+// velocity, the body position from the voxel hull, arm directions from the 3D
+// arm axis points, default poses, and a hook for posture recognition — a
+// 2D-3D ICP refinement of a random subset (icp.h), joint limits and
+// resampling. The best particle gives the joints and the pointing rays.
+//
+// It reads only front-end features (silhouettes, 3D axis points, the voxel
+// hull's placement), the calibration and the surveyed screens: never truth.
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "sim/camera/camera.h"
+#include "sim/scene/screen.h"
+#include "tracker/frontend/frontend.h"
+#include "tracker/model/body_model.h"
+#include "tracker/pose/icp.h"
+#include "tracker/pose/observation.h"
+#include "tracker/pose/pointing.h"
+
+namespace irbench {
+
+struct PoseTrackerOptions {
+  int particles = 100;
+  uint64_t seed = 1;
+  ObservationOptions observation;
+  // Proposal choice per particle (thesis 6.3.2), relative weights.
+  double p_random_walk = 0.70;
+  double p_body_position = 0.10;
+  double p_arm_direction = 0.12;
+  double p_default_pose = 0.08;
+  // Random-walk noise per frame at 30 fps (scaled by sqrt(dt * 30)).
+  double sigma_position_m = 0.02;
+  double sigma_yaw_rad = 0.06;
+  double sigma_torso_rad = 0.03;
+  double sigma_arm_rad = 0.12;
+  // Velocity: the fraction of the last frame's change carried forward, and its
+  // cap per frame (thesis: "a value cap of velocity ... needs to be applied").
+  double velocity_damping = 0.5;
+  double max_step_rad = 0.35;
+  double max_step_m = 0.08;
+  // Above this ground speed of the hull (m/s) the body-position proposal also
+  // turns the body to face where it walks.
+  double walking_speed_mps = 0.35;
+  // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
+  double refine_fraction = 0.2;
+  IcpOptions icp;
+  // Tracking is declared when the voxel hull sees a person and the best
+  // particle's mean overlap ratio reaches this.
+  double min_overlap = 0.35;
+  // Frames over which the height is estimated after a user enters (the median
+  // of the hull's top while the arms are below the shoulders).
+  int height_frames = 15;
+  void Check() const;  // throws std::invalid_argument
+};
+
+struct PoseEstimate {
+  bool tracking = false;
+  BodyShape shape;
+  BodyPose pose;
+  PosedBody body;
+  std::vector<double> overlap;  // per camera, the best particle's overlap ratio
+  double log_likelihood = 0;
+  std::optional<PointingRay> pointing[2];  // right, left
+  double ms_observation = 0, ms_refine = 0, ms_total = 0;
+};
+
+// Extra proposals, e.g. from posture recognition (thesis 6.3.2, "Shape
+// Descriptor & Posture Recognition Function"): poses to seed particles with.
+using PoseProposalHook = std::function<std::vector<BodyPose>(const FrameFeatures&, const BodyShape&)>;
+
+class PoseTracker {
+ public:
+  // `facing`: the direction users face when they enter (towards the screen,
+  // from the surveyed screen geometry), world xy.
+  PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface> screens, const PoseTrackerOptions& options);
+
+  // One frame-set: `dt` seconds after the previous one.
+  PoseEstimate Step(const FrameFeatures& features, double dt);
+
+  void set_proposal_hook(PoseProposalHook hook) { hook_ = std::move(hook); }
+  // Scatters the particles uniformly over the stage (for the recovery test:
+  // thesis 6.6 reports recovery in 2-3 frames).
+  void Scatter();
+  const std::vector<BodyPose>& particles() const { return particles_; }
+
+ private:
+  void Initialise(const FrameFeatures& features);
+  BodyPose Propose(const BodyPose& current, const BodyPose& previous, const FrameFeatures& features, double dt);
+  BodyPose ArmDirectionProposal(BodyPose pose, const FrameFeatures& features);
+  BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
+  double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
+
+  std::vector<Camera> cameras_;
+  std::vector<Eigen::Matrix<double, 3, 4>> projections_;
+  std::vector<cv::Mat> map1_, map2_;
+  std::vector<ScreenSurface> screens_;
+  PoseTrackerOptions options_;
+  std::mt19937_64 rng_;
+  PoseProposalHook hook_;
+  Eigen::Vector2d facing_xy_ = Eigen::Vector2d::UnitY();
+
+  bool active_ = false;
+  BodyShape shape_;
+  std::vector<double> heights_;
+  std::vector<BodyPose> particles_, previous_;
+  Eigen::Vector2d last_root_xy_ = Eigen::Vector2d::Zero(), velocity_xy_ = Eigen::Vector2d::Zero();
+  bool walking_ = false;
+};
+
+}  // namespace irbench
