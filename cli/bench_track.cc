@@ -8,6 +8,7 @@
 
 #include "common/logging.h"
 #include "tracker/frontend/frontend.h"
+#include "tracker/pose/pose_tracker.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -38,16 +39,18 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
     for (size_t c = 0; c < input.cameras().size(); ++c) images[f].push_back(input.Frame(static_cast<int>(c), f));
   }
   std::vector<double> sil, axes, polygons, voxels, polyhedral, total;
+  std::vector<FrameFeatures> all_features;
   for (int r = 0; r < repeats; ++r) {
     for (int f = 0; f < input.frame_count(); ++f) {
       const auto start = std::chrono::steady_clock::now();
-      const FrameFeatures features = front_end.Process(f, images[f]);
+      FrameFeatures features = front_end.Process(f, images[f]);
       total.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
       sil.push_back(features.ms_silhouettes);
       axes.push_back(features.ms_axes);
       polygons.push_back(features.ms_polygons);
       voxels.push_back(features.ms_voxels);
       polyhedral.push_back(features.ms_polyhedral);
+      if (r == 0) all_features.push_back(std::move(features));
     }
   }
   auto row = [](const std::string& stage, std::vector<double> v) {
@@ -56,10 +59,29 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
     for (double x : v) sum += x;
     return TrackBenchRow{stage, v[v.size() / 2], sum / v.size()};
   };
-  return {row("silhouettes (background model, morphology, shadow removal)", sil),
-          row("2D axis points, body parts, 3D axis points", axes), row("silhouette polygons", polygons),
-          row("voxel hull (2 cm, look-up table)", voxels), row("polyhedral hull (on request)", polyhedral),
-          row("front end, all stages (polyhedral hull included)", total)};
+  std::vector<TrackBenchRow> rows = {
+      row("silhouettes (background model, morphology, shadow removal)", sil),
+      row("2D axis points, body parts, 3D axis points", axes), row("silhouette polygons", polygons),
+      row("voxel hull (2 cm, look-up table)", voxels), row("polyhedral hull (on request)", polyhedral),
+      row("front end, all stages (polyhedral hull included)", total)};
+  // The pose tracker (thesis 6.3) against particle count, on the same
+  // features; frame-sets where it tracks.
+  for (int particles : {25, 50, 100, 200, 400}) {
+    std::vector<double> pose_ms;
+    for (int r = 0; r < repeats; ++r) {
+      PoseTrackerOptions pose_options;
+      pose_options.particles = particles;
+      PoseTracker tracker(input.cameras(), input.screens(), pose_options);
+      for (const FrameFeatures& features : all_features) {
+        const PoseEstimate e = tracker.Step(features, 1.0 / input.fps());
+        if (e.tracking) pose_ms.push_back(e.ms_total);
+      }
+    }
+    if (pose_ms.empty()) continue;
+    TrackBenchRow pose_row = row("pose tracker, " + std::to_string(particles) + " particles (20% refined by ICP)", pose_ms);
+    rows.push_back(pose_row);
+  }
+  return rows;
 }
 
 }  // namespace irbench

@@ -18,6 +18,7 @@
 #include "ci/score/score.h"
 #include "ci/suite/suite.h"
 #include "tracker/pipeline/track_job.h"
+#include "ci/train/rest_training.h"
 
 namespace {
 
@@ -104,6 +105,9 @@ int main(int argc, char** argv) {
   track_cmd->add_option("--particles", track.particles, "pose: particles of the filter (thesis 6.3)")
       ->capture_default_str();
   track_cmd->add_option("--seed", track.seed, "pose: seed of the filter's random stream")->capture_default_str();
+  std::string track_rest_model;
+  track_cmd->add_option("--rest-model", track_rest_model,
+                        "pose: rest-state SVM (default: tracker/models/rest_svm.yml when present)");
   track_cmd->add_option("--background-model", track.background_model,
                         "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)")
       ->capture_default_str();
@@ -195,6 +199,22 @@ int main(int argc, char** argv) {
   avatar_export->add_option("OUT", avatar_out, "output .glb file")->required();
   avatar_export->add_flag("--force", avatar_force, "replace an existing file");
 
+  // train
+  CLI::App* train_cmd = app.add_subcommand("train", "Train the tracker's learned parts from simulated truth");
+  train_cmd->require_subcommand(1);
+  irbench::RestTrainingOptions train_rest;
+  std::string train_rest_out;
+  CLI::App* train_rest_cmd = train_cmd->add_subcommand(
+      "rest", "Rest-state SVM (thesis 6.4): RBF SVM on elbow and wrist in the upper-body frame, C and gamma\n"
+              "by k-fold cross-validation, from library motions played on avatars (no rendering)");
+  train_rest_cmd->add_option("--avatars", train_rest.avatars, "avatars to sample")->capture_default_str();
+  train_rest_cmd->add_option("--motions", train_rest.motions, "library motions or motion files")
+      ->capture_default_str();
+  train_rest_cmd->add_option("--fps", train_rest.sample_fps, "samples per second of motion")->capture_default_str();
+  train_rest_cmd->add_option("--folds", train_rest.folds, "cross-validation folds")->capture_default_str();
+  train_rest_cmd->add_option("--seed", train_rest.seed, "seed of the motions' styles")->capture_default_str();
+  train_rest_cmd->add_option("--out", train_rest_out, "model file (default: tracker/models/rest_svm.yml)");
+
   // bench
   CLI::App* bench_cmd = app.add_subcommand("bench", "Print throughput figures");
   bench_cmd->require_subcommand(1);
@@ -247,8 +267,17 @@ int main(int argc, char** argv) {
       track.sequence = track_sequence;
       track.out = track_out;
       track.remove_shadows = !track_keep_shadows;
+      track.rest_model = track_rest_model;
       if (track_cmd->count("--frames") > 0) track.frames = track_frames;
       std::cout << irbench::RunTrackJob(track).string() << "\n";
+      return kExitOk;
+    }
+    if (train_rest_cmd->parsed()) {
+      train_rest.out = train_rest_out;
+      const irbench::RestTrainingResult r = irbench::RunRestTraining(train_rest);
+      std::cout << "rest-state SVM: " << r.samples << " arm samples (" << r.at_rest << " at rest), "
+                << train_rest.folds << "-fold cross-validated accuracy " << r.cv_accuracy * 100 << "%\n"
+                << r.model.string() << "\n";
       return kExitOk;
     }
     if (demo_cmd->parsed()) {
@@ -258,8 +287,7 @@ int main(int argc, char** argv) {
       std::cout << r.tables << "\n"
                 << "sequence  " << r.sequence.string() << "\n"
                 << "track     " << r.track.string() << "\n"
-                << "score     " << r.score.string() << "\n"
-                << "(the pose tracker is not built yet: joints other than the root are missing)\n";
+                << "score     " << r.score.string() << "\n";
       return kExitOk;
     }
     if (suite_run->parsed()) {
@@ -320,8 +348,12 @@ int main(int argc, char** argv) {
                   bench_track_render.rig.c_str(), bench_track_render.avatar.c_str(),
                   bench_track_render.motion.c_str(), bench_track_render.sensor.c_str(), cameras,
                   bench_track_frames, bench_track_repeats);
-      std::printf("| stage | median ms per frame-set | mean ms |\n|---|---|---|\n");
-      for (const auto& r : rows) std::printf("| %s | %.2f | %.2f |\n", r.stage.c_str(), r.median_ms, r.mean_ms);
+      std::printf("| stage | median ms per frame-set | mean ms | frame-sets per second (from the mean) |\n"
+                  "|---|---|---|---|\n");
+      for (const auto& r : rows) {
+        std::printf("| %s | %.2f | %.2f | %.1f |\n", r.stage.c_str(), r.median_ms, r.mean_ms,
+                    r.mean_ms > 0 ? 1000.0 / r.mean_ms : 0.0);
+      }
       return kExitOk;
     }
     if (bench_render->parsed()) {

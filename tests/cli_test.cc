@@ -287,7 +287,22 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
     ++count;
   }
   EXPECT_EQ(count, 2);
-  // Again without --force: refused; a stage not built yet, a missing folder, a
+  // The default stage, pose: every frame tracked has the nine scored joints.
+  const Result pose = RunIrbench({"track", (dir / "seq").string(), "--out", (dir / "pose").string()}, dir);
+  ASSERT_EQ(pose.exit_code, 0) << pose.err;
+  std::ifstream pose_lines(dir / "pose" / "track.jsonl");
+  int pose_count = 0;
+  for (std::string l; std::getline(pose_lines, l); ++pose_count) {
+    const auto j = nlohmann::json::parse(l);
+    if (j["state"] != "tracking") continue;
+    for (const char* joint : {"root", "waist", "neck", "left_shoulder", "left_elbow", "left_wrist", "right_shoulder",
+                              "right_elbow", "right_wrist"}) {
+      EXPECT_EQ(j["joints3d"][joint].size(), 3u) << joint;
+    }
+    EXPECT_EQ(j["dof"].size(), 21u);
+  }
+  EXPECT_EQ(pose_count, 2);
+  // Again without --force: refused; an unknown stage, a missing folder, a
   // sequence without empty-stage frames: one line, exit 2, nothing left.
   ASSERT_EQ(RunIrbench({"render", "--rig", "lab4", "--frames", "1", "--background-frames", "0", "--out",
                         (dir / "nobg").string()},
@@ -296,7 +311,11 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
             0);
   for (const auto& [args, expected] :
        {std::pair<std::vector<std::string>, std::string>{{"track", (dir / "seq").string()}, "exists"},
-        {{"track", (dir / "seq").string(), "--stage", "pose", "--out", (dir / "t2").string()}, "--stage"},
+        {{"track", (dir / "seq").string(), "--stage", "skeleton", "--out", (dir / "t2").string()}, "--stage"},
+        {{"track", (dir / "seq").string(), "--particles", "0", "--out", (dir / "t4").string()}, "--particles"},
+        {{"track", (dir / "seq").string(), "--rest-model", (dir / "nosuch.yml").string(), "--out",
+          (dir / "t5").string()},
+         "nosuch.yml"},
         {{"track", (dir / "seq").string(), "--background-model", "mog", "--out", (dir / "t3").string()},
          "--background-model"},
         {{"track", (dir / "missing").string()}, "no such sequence folder"},
@@ -306,7 +325,7 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
-  for (const char* name : {"t2", "t3"}) EXPECT_FALSE(fs::exists(dir / name));
+  for (const char* name : {"t2", "t3", "t4", "t5"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
   // An output that would replace the sequence or land in what it reads.
   for (const auto& [out, expected] : {std::pair<fs::path, std::string>{dir / "seq", "would replace the sequence"},

@@ -165,6 +165,13 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     pose_options.particles = options.particles;
     pose_options.seed = options.seed;
     pose_tracker.emplace(input.cameras(), input.screens(), pose_options);
+    const fs::path rest_path = options.rest_model.empty() ? DefaultRestModelPath() : options.rest_model;
+    if (!options.rest_model.empty() || fs::exists(rest_path)) {
+      pose_tracker->set_rest_classifier(std::make_shared<RestClassifier>(RestClassifier::Load(rest_path)));
+      Log().info("track: rest-state model {}", rest_path.string());
+    } else {
+      Log().warn("track: no rest-state model at {} (irbench train rest); rest stays null", rest_path.string());
+    }
   }
   std::string lines, track_lines;
   const auto start = std::chrono::steady_clock::now();
@@ -265,6 +272,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
         pointing[side == 0 ? "right" : "left"] = j;
       }
       track_line["pointing"] = pointing;
+      if (pose->rest[0] && pose->rest[1]) track_line["rest"] = {{"right", *pose->rest[0]}, {"left", *pose->rest[1]}};
       track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
       nlohmann::json overlap = nlohmann::json::object();
       for (size_t c = 0; c < pose->overlap.size(); ++c) {

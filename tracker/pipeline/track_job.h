@@ -35,6 +35,9 @@ struct TrackJobOptions {
   std::string stage = "pose";  // or "features" (front end only)
   int particles = 100;         // pose: particles of the filter (thesis 6.3)
   uint64_t seed = 1;           // pose: the filter's random stream
+  // pose: the rest-state SVM (irbench train rest); empty: the default model
+  // (tracker/models/rest_svm.yml) when it exists, else rest stays null.
+  std::filesystem::path rest_model;
   std::string background_model = "flicker";  // or "plain" (thesis 3.1)
   bool remove_shadows = true;
   bool overlays = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <numeric>
 #include <opencv2/core/utility.hpp>
@@ -76,7 +77,12 @@ PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface>
 
 double PoseTracker::Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views,
                              std::vector<double>* overlaps) const {
-  const PosedBody body = PoseBody(shape_, pose);
+  return Evaluate(shape_, pose, views, overlaps);
+}
+
+double PoseTracker::Evaluate(const BodyShape& shape, const BodyPose& pose, const std::vector<SilhouetteView>& views,
+                             std::vector<double>* overlaps) const {
+  const PosedBody body = PoseBody(shape, pose);
   double log_likelihood = 0;
   if (overlaps) overlaps->assign(cameras_.size(), 0.0);
   for (size_t c = 0; c < cameras_.size(); ++c) {
@@ -103,7 +109,7 @@ double YawFacing(const Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
 
 void PoseTracker::Initialise(const FrameFeatures& features) {
   const BodyPlacement& place = *features.placement;
-  heights_ = {place.top_m};
+  heights_.clear();
   shape_ = BodyShape::FromHeight(std::clamp(place.top_m, 1.2, 2.2));
   const Vector2d root = place.root.head<2>();
   Vector2d to_screen = facing_xy_;
@@ -270,8 +276,8 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     next.dof[kDofY] += k * options_.sigma_position_m * n01(rng_);
     next.dof[kDofZ] += 0.3 * k * options_.sigma_position_m * n01(rng_);
     next.dof[kDofYaw] += k * options_.sigma_yaw_rad * n01(rng_);
-    next.dof[kDofPitch] += 0.3 * k * options_.sigma_torso_rad * n01(rng_);
-    next.dof[kDofRoll] += 0.3 * k * options_.sigma_torso_rad * n01(rng_);
+    // The body's pitch and roll stay as they are (zero): the legs' ellipsoid
+    // says little about them, and bowing or leaning is the waist's.
     for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) {
       next.dof[d] += k * options_.sigma_torso_rad * n01(rng_);
     }
@@ -382,14 +388,27 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   out.pose = proposed[best];
 
   // Height (thesis 6.1.2): configured when the user enters, from the hull's
-  // top while the arms are below the shoulders; the particles keep their
-  // angles and move their waist heights with the scale.
+  // top while the arms are below the shoulders, each frame's value checked
+  // against the silhouettes at a few scales about it (the hull's top loses
+  // or gains a voxel or two); the median over the first frames. The
+  // particles keep their angles and move their waist heights with the scale.
   {
     const PosedBody body = PoseBody(shape_, out.pose);
     const bool arms_low = body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
                           body.joints[kModelLeftHandTip].z() < body.joints[kModelLeftShoulder].z();
     if (out.tracking && arms_low && static_cast<int>(heights_.size()) < options_.height_frames) {
-      heights_.push_back(features.placement->top_m);
+      double best_ll = -std::numeric_limits<double>::infinity(), best_height = features.placement->top_m;
+      for (double scale = 0.94; scale < 1.065; scale += 0.02) {
+        const double height = std::clamp(features.placement->top_m * scale, 1.2, 2.2);
+        BodyPose p = out.pose;
+        p.dof[kDofZ] *= height / shape_.height_m;
+        const double ll = Evaluate(BodyShape::FromHeight(height), p, views, nullptr);
+        if (ll > best_ll) {
+          best_ll = ll;
+          best_height = height;
+        }
+      }
+      heights_.push_back(best_height);
       const double height = std::clamp(Median(heights_), 1.2, 2.2);
       const double ratio = height / shape_.height_m;
       shape_ = BodyShape::FromHeight(height);
@@ -400,9 +419,35 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   }
   out.shape = shape_;
   out.body = PoseBody(shape_, out.pose);
+  if (out.tracking && rest_ && !rest_->empty()) {
+    // Thesis 6.4: an arm at rest is forced down.
+    const auto& j = out.body.joints;
+    for (int side = 0; side < 2; ++side) {
+      const bool left = side == 1;
+      const bool at_rest = rest_->AtRest(RestFeatures(
+          j[kModelWaist], j[kModelNeck], j[kModelRightShoulder], j[kModelLeftShoulder],
+          j[left ? kModelLeftElbow : kModelRightElbow], j[left ? kModelLeftWrist : kModelRightWrist],
+          shape_.height_m, left));
+      out.rest[side] = at_rest;
+      if (at_rest) {
+        const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
+        const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
+        out.pose.dof[sh] = 0.0;
+        out.pose.dof[sh + 1] = 0.1;
+        out.pose.dof[sh + 2] = 0.0;
+        out.pose.dof[el] = 0.0;
+        out.pose.dof[el + 1] = 0.0;
+      }
+    }
+    out.body = PoseBody(shape_, out.pose);
+  }
   if (out.tracking) {
-    out.pointing[0] = Pointing(out.body.joints[kModelHead], out.body.joints[kModelRightHandTip], screens_);
-    out.pointing[1] = Pointing(out.body.joints[kModelHead], out.body.joints[kModelLeftHandTip], screens_);
+    if (!out.rest[0].value_or(false)) {
+      out.pointing[0] = Pointing(out.body.joints[kModelHead], out.body.joints[kModelRightHandTip], screens_);
+    }
+    if (!out.rest[1].value_or(false)) {
+      out.pointing[1] = Pointing(out.body.joints[kModelHead], out.body.joints[kModelLeftHandTip], screens_);
+    }
   }
 
   // Resampling (systematic), carrying each particle's previous state along

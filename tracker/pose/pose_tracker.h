@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <random>
 #include <vector>
@@ -23,6 +24,7 @@
 #include "tracker/pose/icp.h"
 #include "tracker/pose/observation.h"
 #include "tracker/pose/pointing.h"
+#include "tracker/pose/rest_state.h"
 
 namespace irbench {
 
@@ -67,7 +69,8 @@ struct PoseEstimate {
   PosedBody body;
   std::vector<double> overlap;  // per camera, the best particle's overlap ratio
   double log_likelihood = 0;
-  std::optional<PointingRay> pointing[2];  // right, left
+  std::optional<PointingRay> pointing[2];  // right, left; none for an arm at rest
+  std::optional<bool> rest[2];              // right, left; none without a rest classifier
   double ms_observation = 0, ms_refine = 0, ms_total = 0;
 };
 
@@ -85,6 +88,9 @@ class PoseTracker {
   PoseEstimate Step(const FrameFeatures& features, double dt);
 
   void set_proposal_hook(PoseProposalHook hook) { hook_ = std::move(hook); }
+  // The rest-state classifier (thesis 6.4); an arm it finds at rest is
+  // forced down in the estimate.
+  void set_rest_classifier(std::shared_ptr<const RestClassifier> rest) { rest_ = std::move(rest); }
   // Scatters the particles uniformly over the stage (for the recovery test:
   // thesis 6.6 reports recovery in 2-3 frames).
   void Scatter();
@@ -96,6 +102,8 @@ class PoseTracker {
   BodyPose ArmDirectionProposal(BodyPose pose, const FrameFeatures& features);
   BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
+  double Evaluate(const BodyShape& shape, const BodyPose& pose, const std::vector<SilhouetteView>& views,
+                  std::vector<double>* overlaps) const;
 
   std::vector<Camera> cameras_;
   std::vector<Eigen::Matrix<double, 3, 4>> projections_;
@@ -104,6 +112,7 @@ class PoseTracker {
   PoseTrackerOptions options_;
   std::mt19937_64 rng_;
   PoseProposalHook hook_;
+  std::shared_ptr<const RestClassifier> rest_;
   Eigen::Vector2d facing_xy_ = Eigen::Vector2d::UnitY();
 
   bool active_ = false;

@@ -1,0 +1,181 @@
+// Pose tracking against the truth on a rendered sequence (issue 7's short CI
+// case): theater4, the `thesis` sensor preset, a person walking in, pointing
+// at a screen target, raising an arm and directing traffic. The tracker sees
+// only frames, calibration and empty-stage frames (SequenceInput); this test
+// reads the truth to score it. The full figures (five persons, the demo
+// session) are in the issue notes, made with `irbench demo` / `irbench score`.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "sim/sequence/render_job.h"
+#include "tests/test_util.h"
+#include "tracker/frontend/frontend.h"
+#include "tracker/io/sequence_input.h"
+#include "tracker/pose/pose_tracker.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+using irbench::testing::FreshTempDir;
+using irbench::testing::WriteText;
+
+Eigen::Vector3d V(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
+
+int ModelIndex(const std::string& name) {
+  for (int j = 0; j < kModelJointCount; ++j) {
+    if (name == ModelJointName(j)) return j;
+  }
+  return -1;
+}
+
+double Mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / v.size();
+}
+
+class PoseClosedLoopTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(FreshTempDir("pose_closed_loop_" + std::to_string(getpid())));
+    WriteText(*dir_ / "session.json", R"({"format": "irbench.session/1", "crossfade_s": 0.2, "items": [
+      {"motion": "enter", "to": [0.0, 0.0]},
+      {"motion": "point", "target": "helicopter", "hold_s": 0.6},
+      {"motion": "raise_overhead", "hold_s": 0.3},
+      {"motion": "direct_traffic", "target": "truck", "cycles": 1}]})");
+    RenderJobOptions options;
+    options.rig = "theater4";
+    options.avatar = "p2";
+    options.motion = (*dir_ / "session.json").string();
+    options.sensor = "thesis";
+    options.background_frames = 12;
+    options.seed = 5;
+    options.out = *dir_ / "seq";
+    seq_ = new fs::path(RunRenderJob(options));
+    std::ifstream in(*seq_ / "truth/frames.jsonl");
+    truth_ = new std::vector<nlohmann::json>;
+    for (std::string line; std::getline(in, line);) truth_->push_back(nlohmann::json::parse(line));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+    delete seq_;
+    delete truth_;
+  }
+  // The first frame with every scored joint inside every camera's image.
+  static int FullyInside() {
+    for (const nlohmann::json& t : *truth_) {
+      if (!t["present"].get<bool>()) continue;
+      bool inside = true;
+      for (const auto& [cam, joints] : t["joints2d"].items()) {
+        for (const char* j : {"root", "waist", "neck", "head", "left_shoulder", "right_shoulder"}) {
+          inside &= joints[j][2].get<int>() > 0;
+        }
+      }
+      if (inside) return t["frame"].get<int>();
+    }
+    return -1;
+  }
+  static double RootError(const PoseEstimate& e, const nlohmann::json& t) {
+    return (e.body.joints[kModelRoot] - V(t["joints3d"]["root"])).norm();
+  }
+
+  static fs::path* dir_;
+  static fs::path* seq_;
+  static std::vector<nlohmann::json>* truth_;
+};
+fs::path* PoseClosedLoopTest::dir_ = nullptr;
+fs::path* PoseClosedLoopTest::seq_ = nullptr;
+std::vector<nlohmann::json>* PoseClosedLoopTest::truth_ = nullptr;
+
+TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
+  const SequenceInput input = SequenceInput::Open(*seq_);
+  const FrontEnd front_end = FrontEnd::Train(input, {});
+  PoseTracker tracker(input.cameras(), input.screens(), {});
+  std::map<std::string, std::vector<double>> errors;
+  std::vector<double> pointing_deg;
+  int first_tracking = -1;
+  const int inside = FullyInside();
+  ASSERT_GT(inside, 0) << "the person should walk in from outside the views";
+  for (int f = 0; f < input.frame_count(); ++f) {
+    std::vector<cv::Mat> images;
+    for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
+    const PoseEstimate e = tracker.Step(front_end.Process(f, images), 1.0 / input.fps());
+    const nlohmann::json& t = (*truth_)[f];
+    if (!t["present"].get<bool>()) continue;
+    // Tracking has started once the tracker says so and the root is right.
+    if (first_tracking < 0 && e.tracking && RootError(e, t) < 0.10) first_tracking = f;
+    if (f < inside + 10 || !e.tracking) continue;
+    for (const char* name : {"root", "waist", "neck", "left_shoulder", "right_shoulder"}) {
+      errors[name].push_back((e.body.joints[ModelIndex(name)] - V(t["joints3d"][name])).norm());
+    }
+    for (const char* side : {"left", "right"}) {
+      if (t["labels"]["rest"][side].get<bool>()) continue;  // thesis 6.6 scores moving arms
+      for (const char* j : {"elbow", "wrist"}) {
+        const std::string name = std::string(side) + "_" + j;
+        errors[name].push_back((e.body.joints[ModelIndex(name)] - V(t["joints3d"][name])).norm());
+      }
+      const nlohmann::json& ray = t["pointing"][side];
+      const auto& tracked = e.pointing[std::string(side) == "right" ? 0 : 1];
+      if (!ray.is_null() && tracked) {
+        pointing_deg.push_back(std::acos(std::clamp(tracked->dir.dot(V(ray["dir"]).normalized()), -1.0, 1.0)) * 180 /
+                               M_PI);
+      }
+    }
+  }
+  ASSERT_GE(first_tracking, 0);
+  EXPECT_LE(first_tracking, inside + 10) << "fully inside at " << inside;
+  for (const auto& [name, e] : errors) {
+    RecordProperty(name + "_mean_cm", std::to_string(Mean(e) * 100));
+    std::printf("%-16s mean %5.2f cm over %zu frames\n", name.c_str(), Mean(e) * 100, e.size());
+  }
+  std::printf("pointing         mean %5.2f deg over %zu frames\n", Mean(pointing_deg), pointing_deg.size());
+  // Issue 7's bars: 5 cm shoulders, elbows, wrists; 4 cm waist and neck; root
+  // (bar 5 cm) see the note; pointing 3 deg.
+  for (const char* arm : {"left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist",
+                          "right_wrist"}) {
+    if (errors[arm].size() < 10) continue;  // an arm that never moved
+    EXPECT_LT(Mean(errors[arm]), 0.05) << arm;
+  }
+  EXPECT_LT(Mean(errors["waist"]), 0.04);
+  EXPECT_LT(Mean(errors["neck"]), 0.04);
+  EXPECT_LT(Mean(errors["root"]), 0.10);
+  ASSERT_GT(pointing_deg.size(), 10u);
+  EXPECT_LT(Mean(pointing_deg), 3.0);
+}
+
+// Thesis 6.6 reports recovery in 2-3 frames after a loss: scatter the
+// particles over the stage and count frames until the body is found again.
+TEST_F(PoseClosedLoopTest, RecoversWithinThreeFramesAfterTheParticlesAreScattered) {
+  const SequenceInput input = SequenceInput::Open(*seq_);
+  const FrontEnd front_end = FrontEnd::Train(input, {});
+  PoseTracker tracker(input.cameras(), input.screens(), {});
+  const int inside = FullyInside();
+  std::vector<int> recovery;
+  int scattered_at = -1;
+  for (int f = 0; f < input.frame_count(); ++f) {
+    std::vector<cv::Mat> images;
+    for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
+    if (f > inside + 15 && (f - inside) % 25 == 0) {
+      tracker.Scatter();
+      scattered_at = f;
+    }
+    const PoseEstimate e = tracker.Step(front_end.Process(f, images), 1.0 / input.fps());
+    if (scattered_at >= 0 && e.tracking && RootError(e, (*truth_)[f]) < 0.08) {
+      recovery.push_back(f - scattered_at + 1);
+      scattered_at = -1;
+    } else if (scattered_at >= 0 && f - scattered_at >= 10) {
+      recovery.push_back(99);
+      scattered_at = -1;
+    }
+  }
+  ASSERT_GE(recovery.size(), 2u);
+  for (int r : recovery) EXPECT_LE(r, 3);
+}
+
+}  // namespace
+}  // namespace irbench
