@@ -80,6 +80,15 @@ double PoseTracker::Evaluate(const BodyPose& pose, const std::vector<SilhouetteV
   return Evaluate(shape_, pose, views, overlaps);
 }
 
+double PoseTracker::HeadingPrior(const BodyPose& pose) const {
+  auto away = [&](const Vector2d& dir) {
+    const double yaw = std::atan2(-dir.x(), dir.y());
+    return (1.0 - std::cos(pose.dof[kDofYaw] - yaw)) / 2;
+  };
+  if (walking_) return -options_.walking_heading_prior * away(velocity_xy_.normalized());
+  return -options_.screen_heading_prior * away(facing_xy_);
+}
+
 double PoseTracker::Evaluate(const BodyShape& shape, const BodyPose& pose, const std::vector<SilhouetteView>& views,
                              std::vector<double>* overlaps) const {
   const PosedBody body = PoseBody(shape, pose);
@@ -264,7 +273,14 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
   std::normal_distribution<double> n01(0.0, 1.0);
   const double k = std::sqrt(std::max(dt, 1e-3) * 30.0);
   BodyPose next = current;
-  if (choice < options_.p_random_walk) {
+  if (lost_ && u(rng_) < 0.5 * total) {
+    // Lost (the best particle explained the silhouettes poorly last frame):
+    // half the particles restart from default poses where the hull is,
+    // facing the screen (thesis 6.6: recovery within 2-3 frames).
+    BodyPose facing = current;
+    facing.dof[kDofYaw] = YawFacing(facing_xy_) + 0.3 * n01(rng_);
+    next = DefaultPoseProposal(facing, features);
+  } else if (choice < options_.p_random_walk) {
     // Random walk with velocity (thesis 6.3.2), capped.
     for (int d = 0; d < kDofCount; ++d) {
       double v = current.dof[d] - previous.dof[d];
@@ -297,6 +313,13 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
   } else {
     next = DefaultPoseProposal(current, features);
   }
+  // While the user walks, a particle facing more than 90 deg away from the
+  // walking direction is turned to it (people do not walk backwards onto a
+  // stage; silhouettes cannot tell front from back).
+  if (walking_) {
+    const double heading = YawFacing(velocity_xy_.normalized());
+    if (std::cos(next.dof[kDofYaw] - heading) < 0) next.dof[kDofYaw] = heading + 0.1 * n01(rng_);
+  }
   ClampToJointLimits(&next);
   return next;
 }
@@ -306,6 +329,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   PoseEstimate out;
   if (!features.placement || features.cameras.size() != cameras_.size()) {
     active_ = false;
+    lost_ = false;
     out.ms_total = Millis(start);
     return out;
   }
@@ -318,14 +342,17 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     }
   }
 
-  // The hull's ground velocity, smoothed: a walking user's heading.
+  // The hull's ground velocity over the last half second (single frames are
+  // too noisy: a centimetre of jitter per frame reads as 0.4 m/s): a walking
+  // user's heading.
   const Vector2d root_xy = features.placement->root.head<2>();
-  if (active_ && dt > 0) {
-    velocity_xy_ = 0.6 * velocity_xy_ + 0.4 * (root_xy - last_root_xy_) / dt;
-  } else {
-    velocity_xy_.setZero();
-  }
-  last_root_xy_ = root_xy;
+  if (!active_) recent_roots_.clear();
+  recent_roots_.push_back(root_xy);
+  const size_t window = static_cast<size_t>(std::max(2.0, std::round(0.5 / std::max(dt, 1e-3))));
+  while (recent_roots_.size() > window + 1) recent_roots_.pop_front();
+  velocity_xy_ = recent_roots_.size() > window / 2
+                     ? Vector2d((recent_roots_.back() - recent_roots_.front()) / ((recent_roots_.size() - 1) * dt))
+                     : Vector2d::Zero();
   walking_ = velocity_xy_.norm() > options_.walking_speed_mps;
 
   std::vector<BodyPose> proposed;
@@ -350,7 +377,9 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   std::vector<double> log_likelihood(n);
   const auto t_obs = std::chrono::steady_clock::now();
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) log_likelihood[i] = Evaluate(proposed[i], views, nullptr);
+    for (int i = r.start; i < r.end; ++i) {
+      log_likelihood[i] = Evaluate(proposed[i], views, nullptr) + HeadingPrior(proposed[i]);
+    }
   });
   out.ms_observation = Millis(t_obs);
 
@@ -368,7 +397,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
       for (int j = r.start; j < r.end; ++j) {
         refined[j] = RefineIcp(shape_, proposed[order[j]], icp_views, options_.icp);
-        refined_ll[j] = Evaluate(refined[j], views, nullptr);
+        refined_ll[j] = Evaluate(refined[j], views, nullptr) + HeadingPrior(refined[j]);
       }
     });
     for (int j = 0; j < refine; ++j) {
@@ -472,6 +501,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   }
   particles_ = std::move(next);
   previous_ = std::move(next_previous);
+  lost_ = !out.tracking;
   out.ms_total = Millis(start);
   return out;
 }

@@ -11,6 +11,7 @@
 // hull's placement), the calibration and the surveyed screens: never truth.
 
 #include <Eigen/Core>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -50,6 +51,12 @@ struct PoseTrackerOptions {
   // Above this ground speed of the hull (m/s) the body-position proposal also
   // turns the body to face where it walks.
   double walking_speed_mps = 0.35;
+  // Heading priors, added to the log-likelihood as -w * (1 - cos(d)) / 2 for a
+  // heading d away from the preferred one: people face where they walk, and
+  // otherwise mostly face the screen. They only decide between hypotheses the
+  // silhouettes cannot tell apart (front and back look alike).
+  double walking_heading_prior = 5.0;
+  double screen_heading_prior = 1.5;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
@@ -102,6 +109,7 @@ class PoseTracker {
   BodyPose ArmDirectionProposal(BodyPose pose, const FrameFeatures& features);
   BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
+  double HeadingPrior(const BodyPose& pose) const;
   double Evaluate(const BodyShape& shape, const BodyPose& pose, const std::vector<SilhouetteView>& views,
                   std::vector<double>* overlaps) const;
 
@@ -119,8 +127,10 @@ class PoseTracker {
   BodyShape shape_;
   std::vector<double> heights_;
   std::vector<BodyPose> particles_, previous_;
-  Eigen::Vector2d last_root_xy_ = Eigen::Vector2d::Zero(), velocity_xy_ = Eigen::Vector2d::Zero();
+  std::deque<Eigen::Vector2d> recent_roots_;
+  Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();
   bool walking_ = false;
+  bool lost_ = false;
 };
 
 }  // namespace irbench
