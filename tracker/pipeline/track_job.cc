@@ -139,6 +139,16 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     }
   }
   const SequenceInput input = SequenceInput::Open(options.sequence);
+  // The rest-state model is checked before any work is done.
+  std::shared_ptr<const RestClassifier> rest_classifier;
+  if (options.stage == "pose") {
+    const fs::path rest_path = options.rest_model.empty() ? DefaultRestModelPath() : options.rest_model;
+    if (!options.rest_model.empty() || fs::exists(rest_path)) {
+      rest_classifier = std::make_shared<RestClassifier>(RestClassifier::Load(rest_path));
+    } else {
+      Log().warn("track: no rest-state model at {} (irbench train rest); rest stays null", rest_path.string());
+    }
+  }
   int frames = input.frame_count();
   if (options.frames) {
     if (*options.frames < 1) throw InputError("", "--frames", "must be at least 1");
@@ -165,13 +175,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     pose_options.particles = options.particles;
     pose_options.seed = options.seed;
     pose_tracker.emplace(input.cameras(), input.screens(), pose_options);
-    const fs::path rest_path = options.rest_model.empty() ? DefaultRestModelPath() : options.rest_model;
-    if (!options.rest_model.empty() || fs::exists(rest_path)) {
-      pose_tracker->set_rest_classifier(std::make_shared<RestClassifier>(RestClassifier::Load(rest_path)));
-      Log().info("track: rest-state model {}", rest_path.string());
-    } else {
-      Log().warn("track: no rest-state model at {} (irbench train rest); rest stays null", rest_path.string());
-    }
+    if (rest_classifier) pose_tracker->set_rest_classifier(rest_classifier);
   }
   std::string lines, track_lines;
   const auto start = std::chrono::steady_clock::now();

@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "common/error.h"
 #include "sim/camera/rig.h"
 #include "tracker/pose/icp.h"
 #include "tracker/pose/observation.h"
@@ -209,6 +210,54 @@ TEST(Pointing, RayFromHeadThroughHandTipHitsTheNearestScreen) {
   EXPECT_NEAR(ray->screen_hit->y(), hit.z(), 1e-9);
   EXPECT_EQ(ray->target.value_or(""), "door");
   EXPECT_FALSE(Pointing(head, head, {near_screen}));
+}
+
+}  // namespace
+}  // namespace irbench
+
+namespace irbench {
+namespace {
+
+// Features of a right arm from its upper-arm and forearm directions in the
+// upper-body frame (x right, y forward, z up), for a body of height 1.
+std::array<float, 6> ArmFeatures(const Eigen::Vector3d& upper, const Eigen::Vector3d& fore) {
+  const Eigen::Vector3d shoulder(0.1, 0, 0.81), elbow = shoulder + 0.186 * upper, wrist = elbow + 0.146 * fore;
+  return RestFeatures(Eigen::Vector3d(0, 0, 0.6), Eigen::Vector3d(0, 0, 0.818), shoulder,
+                      Eigen::Vector3d(-0.1, 0, 0.81), elbow, wrist, 1.0, false);
+}
+
+// The SVM learns the truth's rest rule (sim/motion/labels.h: upper arm within
+// 30 deg of down, forearm within 45 deg) from samples of it.
+TEST(RestState, LearnsTheRestRuleFromSamples) {
+  std::mt19937 rng(8);
+  std::normal_distribution<double> n(0, 1);
+  auto random_dir = [&](double spread) {
+    return Eigen::Vector3d(spread * n(rng), spread * n(rng), -1.0).normalized();
+  };
+  auto rule = [](const Eigen::Vector3d& u, const Eigen::Vector3d& f) {
+    return std::acos(-u.z()) < 30 * M_PI / 180 && std::acos(-f.z()) < 45 * M_PI / 180;
+  };
+  std::vector<std::array<float, 6>> x, test_x;
+  std::vector<int> y, test_y;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d u = random_dir(i % 2 ? 0.4 : 1.5), f = random_dir(i % 3 ? 0.6 : 2.0);
+    (i < 2400 ? x : test_x).push_back(ArmFeatures(u, f));
+    (i < 2400 ? y : test_y).push_back(rule(u, f));
+  }
+  double cv_accuracy = 0;
+  const RestClassifier svm = RestClassifier::Train(x, y, 5, &cv_accuracy);
+  EXPECT_GT(cv_accuracy, 0.92);  // many samples lie near the boundary on purpose
+  int correct = 0;
+  for (size_t i = 0; i < test_x.size(); ++i) correct += svm.AtRest(test_x[i]) == (test_y[i] == 1);
+  EXPECT_GT(correct / double(test_x.size()), 0.92);
+}
+
+TEST(RestState, TheShippedModelLoadsAndKnowsHangingFromPointing) {
+  const RestClassifier svm = RestClassifier::Load(DefaultRestModelPath());
+  EXPECT_TRUE(svm.AtRest(ArmFeatures(Eigen::Vector3d(0.1, 0, -1).normalized(), Eigen::Vector3d(0, 0.1, -1).normalized())));
+  EXPECT_FALSE(svm.AtRest(ArmFeatures(Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 1, 0))));
+  EXPECT_FALSE(svm.AtRest(ArmFeatures(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, 1))));
+  EXPECT_THROW(RestClassifier::Load("/nonexistent/rest.yml"), InputError);
 }
 
 }  // namespace
