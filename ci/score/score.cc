@@ -72,12 +72,13 @@ std::optional<bool> Flag(const Json& line, const std::string& key, const fs::pat
   return Flag(line, key, file, line);
 }
 
-// "tracking" (also when absent) or "empty"; InputError otherwise.
+// "tracking" (also when absent), "partial" (someone partly in view, not
+// scored) or "empty"; InputError otherwise.
 std::string TrackState(const Json& line, const fs::path& file) {
   if (!line.contains("state")) return "tracking";
   const Json& s = line["state"];
-  if (!s.is_string() || (s != "tracking" && s != "empty")) {
-    throw InputError(file.string(), LineField(line, "state"), "expected \"tracking\" or \"empty\"");
+  if (!s.is_string() || (s != "tracking" && s != "empty" && s != "partial")) {
+    throw InputError(file.string(), LineField(line, "state"), "expected \"tracking\", \"partial\" or \"empty\"");
   }
   return s;
 }

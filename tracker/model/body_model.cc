@@ -78,9 +78,10 @@ const char* ModelJointName(int joint) {
   return joint >= 0 && joint < kModelJointCount ? names[joint] : "?";
 }
 
-BodyShape BodyShape::FromHeight(double h) {
+BodyShape BodyShape::FromHeight(double h, double girth) {
   BodyShape s;
   s.height_m = h;
+  s.girth = girth;
   s.waist_height_m = 0.600 * h;
   s.torso_length_m = 0.218 * h;
   s.shoulder_offset_m = 0.100 * h;
@@ -100,6 +101,11 @@ BodyShape BodyShape::FromHeight(double h) {
     s.center_along[arm] = -0.093 * h;
     s.radii[arm + 1] = Vector3d(0.025, 0.025, 0.135) * h;
     s.center_along[arm + 1] = -0.127 * h;
+  }
+  const Eigen::Vector3d wide(girth, girth, 1.0), arm_wide(std::sqrt(girth), std::sqrt(girth), 1.0);
+  for (int seg : {kLowerBody, kUpperBody}) s.radii[seg] = s.radii[seg].cwiseProduct(wide);
+  for (int seg : {kRightUpperArm, kRightLowerArm, kLeftUpperArm, kLeftLowerArm}) {
+    s.radii[seg] = s.radii[seg].cwiseProduct(arm_wide);
   }
   return s;
 }

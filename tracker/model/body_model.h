@@ -65,9 +65,12 @@ const char* BodyDofName(int dof);
 // proportions (Drillis and Contini's segment lengths as fractions of stature,
 // as tabulated by Winter, "Biomechanics and Motor Control of Human Movement")
 // to a stature: thesis 6.1.2, "scale the articulated body model
-// proportionally to the estimated height of the user".
+// proportionally to the estimated height of the user". `girth` widens the
+// torso's and legs' ellipsoids (and the arms' by its square root): the
+// thesis notes height scaling alone fails "users who are too thin or obese".
 struct BodyShape {
   double height_m = 1.75;
+  double girth = 1.0;
   double waist_height_m = 0;     // waist joint above the floor, standing
   double torso_length_m = 0;     // waist joint to neck joint
   double shoulder_offset_m = 0;  // shoulder joint from the body's midline (x)
@@ -82,7 +85,7 @@ struct BodyShape {
   // hanging below it).
   std::array<double, kSegmentCount> center_along;
 
-  static BodyShape FromHeight(double height_m);
+  static BodyShape FromHeight(double height_m, double girth = 1.0);
 };
 
 struct BodyPose {

@@ -242,7 +242,8 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     track_line["frame"] = f;
     track_line["t"] = f / input.fps();
     const bool tracking = pose ? pose->tracking : features.placement.has_value();
-    track_line["state"] = tracking ? "tracking" : "empty";
+    // "partial": someone is there but not yet (or no longer) in every view.
+    track_line["state"] = tracking ? "tracking" : (pose && features.placement && !pose->in_view) ? "partial" : "empty";
     auto rounded = [](const Eigen::Vector3d& p) {
       return nlohmann::json{std::round(p.x() * 1e4) / 1e4, std::round(p.y() * 1e4) / 1e4,
                             std::round(p.z() * 1e4) / 1e4};
@@ -278,6 +279,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
       track_line["pointing"] = pointing;
       if (pose->rest[0] && pose->rest[1]) track_line["rest"] = {{"right", *pose->rest[0]}, {"left", *pose->rest[1]}};
       track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
+      track_line["girth"] = std::round(pose->shape.girth * 1e3) / 1e3;
       nlohmann::json overlap = nlohmann::json::object();
       for (size_t c = 0; c < pose->overlap.size(); ++c) {
         overlap[input.cameras()[c].name] = std::round(pose->overlap[c] * 1e4) / 1e4;

@@ -80,6 +80,23 @@ double PoseTracker::Evaluate(const BodyPose& pose, const std::vector<SilhouetteV
   return Evaluate(shape_, pose, views, overlaps);
 }
 
+bool PoseTracker::InView(const Eigen::Vector3d& root) const {
+  const double top = shape_.height_m;
+  for (const Camera& cam : cameras_) {
+    for (double z : {0.05, 0.5 * top, top}) {
+      for (double dx : {-options_.view_margin_m, options_.view_margin_m}) {
+        for (double dy : {-options_.view_margin_m, options_.view_margin_m}) {
+          const Vector3d p(root.x() + dx, root.y() + dy, z);
+          if ((cam.cam_from_world * p).z() <= 0.05) return false;
+          const Eigen::Vector2d px = cam.Project(p);
+          if (!(px.x() >= 0 && px.y() >= 0 && px.x() <= cam.width - 1 && px.y() <= cam.height - 1)) return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
 double PoseTracker::HeadingPrior(const BodyPose& pose) const {
   auto away = [&](const Vector2d& dir) {
     const double yaw = std::atan2(-dir.x(), dir.y());
@@ -119,6 +136,7 @@ double YawFacing(const Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
 void PoseTracker::Initialise(const FrameFeatures& features) {
   const BodyPlacement& place = *features.placement;
   heights_.clear();
+  girths_.clear();
   shape_ = BodyShape::FromHeight(std::clamp(place.top_m, 1.2, 2.2));
   const Vector2d root = place.root.head<2>();
   Vector2d to_screen = facing_xy_;
@@ -350,10 +368,21 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   recent_roots_.push_back(root_xy);
   const size_t window = static_cast<size_t>(std::max(2.0, std::round(0.5 / std::max(dt, 1e-3))));
   while (recent_roots_.size() > window + 1) recent_roots_.pop_front();
-  velocity_xy_ = recent_roots_.size() > window / 2
-                     ? Vector2d((recent_roots_.back() - recent_roots_.front()) / ((recent_roots_.size() - 1) * dt))
-                     : Vector2d::Zero();
-  walking_ = velocity_xy_.norm() > options_.walking_speed_mps;
+  velocity_xy_.setZero();
+  walking_ = false;
+  if (recent_roots_.size() == window + 1) {
+    // Walking: steady motion, both halves of the window moving the same way
+    // at speed (a shadow or an arm entering the legs' voxels makes the root
+    // jump once, not twice).
+    const size_t mid = window / 2;
+    const Vector2d first = recent_roots_[mid] - recent_roots_.front();
+    const Vector2d second = recent_roots_.back() - recent_roots_[mid];
+    velocity_xy_ = (recent_roots_.back() - recent_roots_.front()) / (window * dt);
+    const double half_min = 0.35 * options_.walking_speed_mps * window * dt;
+    walking_ = velocity_xy_.norm() > options_.walking_speed_mps && first.norm() > half_min &&
+               second.norm() > half_min && first.normalized().dot(second.normalized()) > 0.7;
+  }
+
 
   std::vector<BodyPose> proposed;
   if (!active_) {
@@ -413,7 +442,9 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
                                     log_likelihood.begin());
   out.log_likelihood = Evaluate(proposed[best], views, &out.overlap);
   const double mean_overlap = std::accumulate(out.overlap.begin(), out.overlap.end(), 0.0) / out.overlap.size();
-  out.tracking = mean_overlap >= options_.min_overlap;
+  const bool fits = mean_overlap >= options_.min_overlap;
+  out.in_view = InView(features.placement->root);
+  out.tracking = fits && out.in_view;
   out.pose = proposed[best];
 
   // Height (thesis 6.1.2): configured when the user enters, from the hull's
@@ -426,21 +457,30 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     const bool arms_low = body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
                           body.joints[kModelLeftHandTip].z() < body.joints[kModelLeftShoulder].z();
     if (out.tracking && arms_low && static_cast<int>(heights_.size()) < options_.height_frames) {
+      // Searched with the torso and head upright: a twisted torso is how a
+      // too-narrow model covers a wide body.
       double best_ll = -std::numeric_limits<double>::infinity(), best_height = features.placement->top_m;
+      double best_girth = 1.0;
+      BodyPose upright = out.pose;
+      for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) upright.dof[d] = 0;
       for (double scale = 0.94; scale < 1.065; scale += 0.02) {
-        const double height = std::clamp(features.placement->top_m * scale, 1.2, 2.2);
-        BodyPose p = out.pose;
-        p.dof[kDofZ] *= height / shape_.height_m;
-        const double ll = Evaluate(BodyShape::FromHeight(height), p, views, nullptr);
-        if (ll > best_ll) {
-          best_ll = ll;
-          best_height = height;
+        for (double girth : {0.9, 1.05, 1.2, 1.35, 1.5}) {
+          const double height = std::clamp(features.placement->top_m * scale, 1.2, 2.2);
+          BodyPose p = upright;
+          p.dof[kDofZ] *= height / shape_.height_m;
+          const double ll = Evaluate(BodyShape::FromHeight(height, girth), p, views, nullptr);
+          if (ll > best_ll) {
+            best_ll = ll;
+            best_height = height;
+            best_girth = girth;
+          }
         }
       }
       heights_.push_back(best_height);
+      girths_.push_back(best_girth);
       const double height = std::clamp(Median(heights_), 1.2, 2.2);
       const double ratio = height / shape_.height_m;
-      shape_ = BodyShape::FromHeight(height);
+      shape_ = BodyShape::FromHeight(height, Median(girths_));
       for (BodyPose& p : proposed) p.dof[kDofZ] *= ratio;
       for (BodyPose& p : particles_) p.dof[kDofZ] *= ratio;
       out.pose.dof[kDofZ] *= ratio;
@@ -449,14 +489,27 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   out.shape = shape_;
   out.body = PoseBody(shape_, out.pose);
   if (out.tracking && rest_ && !rest_->empty()) {
-    // Thesis 6.4: an arm at rest is forced down.
-    const auto& j = out.body.joints;
+    // Thesis 6.4: an arm at rest is forced down. The decision is a vote of
+    // the particles, weighted by their likelihood tempered tenfold: an arm
+    // against the torso is poorly determined, and the best particle alone
+    // flickers between nearby poses.
+    std::vector<double> vote_weight(n);
+    for (int i = 0; i < n; ++i) vote_weight[i] = std::exp((log_likelihood[i] - log_likelihood[best]) / 10.0);
     for (int side = 0; side < 2; ++side) {
       const bool left = side == 1;
-      const bool at_rest = rest_->AtRest(RestFeatures(
-          j[kModelWaist], j[kModelNeck], j[kModelRightShoulder], j[kModelLeftShoulder],
-          j[left ? kModelLeftElbow : kModelRightElbow], j[left ? kModelLeftWrist : kModelRightWrist],
-          shape_.height_m, left));
+      double rest_weight = 0, total_weight = 0;
+      for (int i = 0; i < n; ++i) {
+        if (vote_weight[i] < 1e-3) continue;
+        const PosedBody b = PoseBody(shape_, proposed[i]);
+        const auto& j = b.joints;
+        const bool r = rest_->AtRest(RestFeatures(
+            j[kModelWaist], j[kModelNeck], j[kModelRightShoulder], j[kModelLeftShoulder],
+            j[left ? kModelLeftElbow : kModelRightElbow], j[left ? kModelLeftWrist : kModelRightWrist],
+            shape_.height_m, left));
+        rest_weight += r ? vote_weight[i] : 0.0;
+        total_weight += vote_weight[i];
+      }
+      const bool at_rest = rest_weight > 0.5 * total_weight;
       out.rest[side] = at_rest;
       if (at_rest) {
         const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
@@ -501,7 +554,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   }
   particles_ = std::move(next);
   previous_ = std::move(next_previous);
-  lost_ = !out.tracking;
+  lost_ = !fits;
   out.ms_total = Millis(start);
   return out;
 }

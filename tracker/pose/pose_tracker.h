@@ -50,7 +50,7 @@ struct PoseTrackerOptions {
   double max_step_m = 0.08;
   // Above this ground speed of the hull (m/s) the body-position proposal also
   // turns the body to face where it walks.
-  double walking_speed_mps = 0.35;
+  double walking_speed_mps = 0.5;
   // Heading priors, added to the log-likelihood as -w * (1 - cos(d)) / 2 for a
   // heading d away from the preferred one: people face where they walk, and
   // otherwise mostly face the screen. They only decide between hypotheses the
@@ -63,14 +63,23 @@ struct PoseTrackerOptions {
   // Tracking is declared when the voxel hull sees a person and the best
   // particle's mean overlap ratio reaches this.
   double min_overlap = 0.35;
-  // Frames over which the height is estimated after a user enters (the median
-  // of the hull's top while the arms are below the shoulders).
+  // "In view": a box of this half-width about the hull's root, from the floor
+  // to the body's height, projects inside every camera's image.
+  double view_margin_m = 0.35;
+  // Frames over which the height and girth are estimated after a user
+  // enters (medians of per-frame values, while the arms are below the
+  // shoulders).
   int height_frames = 15;
   void Check() const;  // throws std::invalid_argument
 };
 
 struct PoseEstimate {
+  // A person fully in view whose pose the filter explains; false on an empty
+  // stage, while the user is still partly outside some camera's view
+  // (in_view false), and when the best particle explains the silhouettes
+  // poorly (lost).
   bool tracking = false;
+  bool in_view = false;
   BodyShape shape;
   BodyPose pose;
   PosedBody body;
@@ -110,6 +119,7 @@ class PoseTracker {
   BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
   double HeadingPrior(const BodyPose& pose) const;
+  bool InView(const Eigen::Vector3d& root) const;
   double Evaluate(const BodyShape& shape, const BodyPose& pose, const std::vector<SilhouetteView>& views,
                   std::vector<double>* overlaps) const;
 
@@ -125,7 +135,7 @@ class PoseTracker {
 
   bool active_ = false;
   BodyShape shape_;
-  std::vector<double> heights_;
+  std::vector<double> heights_, girths_;
   std::vector<BodyPose> particles_, previous_;
   std::deque<Eigen::Vector2d> recent_roots_;
   Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();
