@@ -366,23 +366,26 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   const Vector2d root_xy = features.placement->root.head<2>();
   if (!active_) recent_roots_.clear();
   recent_roots_.push_back(root_xy);
-  const size_t window = static_cast<size_t>(std::max(2.0, std::round(0.5 / std::max(dt, 1e-3))));
+  const size_t window = static_cast<size_t>(std::max(10.0, std::round(0.5 / std::max(dt, 1e-3))));
   while (recent_roots_.size() > window + 1) recent_roots_.pop_front();
   velocity_xy_.setZero();
   walking_ = false;
   if (recent_roots_.size() == window + 1) {
-    // Walking: steady motion, both halves of the window moving the same way
-    // at speed (a shadow or an arm entering the legs' voxels makes the root
-    // jump once, not twice).
-    const size_t mid = window / 2;
-    const Vector2d first = recent_roots_[mid] - recent_roots_.front();
-    const Vector2d second = recent_roots_.back() - recent_roots_[mid];
-    velocity_xy_ = (recent_roots_.back() - recent_roots_.front()) / (window * dt);
-    const double half_min = 0.35 * options_.walking_speed_mps * window * dt;
-    walking_ = velocity_xy_.norm() > options_.walking_speed_mps && first.norm() > half_min &&
-               second.norm() > half_min && first.normalized().dot(second.normalized()) > 0.7;
+    // Walking: the median of the window's first five roots to the median of
+    // its last five (the hull's root jumps while a user is half in view, and
+    // when a shadow or an arm joins the legs' voxels).
+    auto median_of = [&](size_t from) {
+      std::vector<double> xs, ys;
+      for (size_t i = from; i < from + 5; ++i) {
+        xs.push_back(recent_roots_[i].x());
+        ys.push_back(recent_roots_[i].y());
+      }
+      return Vector2d(Median(xs), Median(ys));
+    };
+    const double span = (window - 4) * dt;
+    velocity_xy_ = (median_of(recent_roots_.size() - 5) - median_of(0)) / span;
+    walking_ = velocity_xy_.norm() > options_.walking_speed_mps;
   }
-
 
   std::vector<BodyPose> proposed;
   if (!active_) {
