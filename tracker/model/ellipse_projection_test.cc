@@ -4,6 +4,7 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <cstdio>
 #include <random>
 
 #include "sim/camera/rig.h"
@@ -68,6 +69,7 @@ TEST(EllipseProjection, RimProjectsOntoTheAnalyticConicWithinFiveHundredthsOfAPi
     }
   }
   EXPECT_GT(checked, 200 * 64 * 3);  // nearly every ellipsoid is in front of nearly every camera
+  std::printf("worst rim distance from the analytic conic: %.2g px over %d points\n", worst, checked);
   EXPECT_LT(worst, 0.05);
 }
 
