@@ -262,3 +262,40 @@ TEST(RestState, TheShippedModelLoadsAndKnowsHangingFromPointing) {
 
 }  // namespace
 }  // namespace irbench
+
+namespace irbench {
+namespace {
+
+// FlippedPose is the front/back twin: turned half way round, each arm is
+// where the other side's arm was (same world positions), so only the
+// ellipsoid torso's orientation differs — which silhouettes barely show.
+TEST(PoseTracker, FlippedPoseKeepsTheArmsWhereTheyWere) {
+  const BodyShape shape = BodyShape::FromHeight(1.8);
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> az(-M_PI, M_PI), zen(0.0, 2.4), yaw(-M_PI, M_PI);
+  for (int trial = 0; trial < 50; ++trial) {
+    BodyPose pose = StandingPose(shape, Eigen::Vector2d(0.2, -0.1), yaw(rng));
+    // Upper arms out to the sides (within the shoulder cap both ways round:
+    // a flipped arm that would point behind the back is clamped, on purpose).
+    std::uniform_real_distribution<double> side(-0.5, 0.5);
+    for (int d : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
+      pose.dof[d] = side(rng);
+      pose.dof[d + 1] = zen(rng);
+    }
+    for (int d : {kDofRightElbowAzimuth, kDofLeftElbowAzimuth}) {
+      pose.dof[d] = az(rng);
+      pose.dof[d + 1] = zen(rng);
+    }
+    ASSERT_TRUE(ClampToJointLimits(&pose));
+    const BodyPose flipped = FlippedPose(pose);
+    const PosedBody a = PoseBody(shape, pose), b = PoseBody(shape, flipped);
+    for (auto [from, to] : {std::pair{kModelRightShoulder, kModelLeftShoulder}, {kModelRightElbow, kModelLeftElbow},
+                            {kModelRightWrist, kModelLeftWrist}, {kModelLeftHandTip, kModelRightHandTip},
+                            {kModelHead, kModelHead}, {kModelRoot, kModelRoot}}) {
+      EXPECT_LT((b.joints[to] - a.joints[from]).norm(), 1e-9) << ModelJointName(from) << " trial " << trial;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace irbench

@@ -282,6 +282,29 @@ BodyPose PoseTracker::DefaultPoseProposal(const BodyPose& current, const FrameFe
   return p;
 }
 
+BodyPose FlippedPose(const BodyPose& pose) {
+  BodyPose f = pose;
+  auto& q = f.dof;
+  q[kDofYaw] += M_PI;
+  q[kDofWaistX] = -pose.dof[kDofWaistX];
+  q[kDofWaistY] = -pose.dof[kDofWaistY];
+  q[kDofNeckAzimuth] = pose.dof[kDofNeckAzimuth] + M_PI;
+  // A right arm along body direction (x, y, z) becomes a left arm along
+  // (-x, -y, z): the same zenith, the azimuth negated (the left arm's angles
+  // mirror x).
+  q[kDofLeftShoulderAzimuth] = -pose.dof[kDofRightShoulderAzimuth];
+  q[kDofLeftShoulderZenith] = pose.dof[kDofRightShoulderZenith];
+  q[kDofRightShoulderAzimuth] = -pose.dof[kDofLeftShoulderAzimuth];
+  q[kDofRightShoulderZenith] = pose.dof[kDofLeftShoulderZenith];
+  q[kDofLeftShoulderTwist] = q[kDofRightShoulderTwist] = 0.0;
+  q[kDofLeftElbowAzimuth] = -pose.dof[kDofRightElbowAzimuth];
+  q[kDofLeftElbowZenith] = pose.dof[kDofRightElbowZenith];
+  q[kDofRightElbowAzimuth] = -pose.dof[kDofLeftElbowAzimuth];
+  q[kDofRightElbowZenith] = pose.dof[kDofLeftElbowZenith];
+  ClampToJointLimits(&f);
+  return f;
+}
+
 BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous, const FrameFeatures& features,
                               double dt) {
   const double total = options_.p_random_walk + options_.p_body_position + options_.p_arm_direction +
@@ -291,7 +314,12 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
   std::normal_distribution<double> n01(0.0, 1.0);
   const double k = std::sqrt(std::max(dt, 1e-3) * 30.0);
   BodyPose next = current;
-  if (lost_ && u(rng_) < 0.5 * total) {
+  if (u(rng_) < options_.p_flip * total) {
+    // Front/back flip (silhouettes barely tell them apart): turned half way
+    // round with the arms swapped so the silhouettes stay nearly the same;
+    // the heading priors and raised arms' joint limits decide.
+    next = FlippedPose(current);
+  } else if (lost_ && u(rng_) < 0.5 * total) {
     // Lost (the best particle explained the silhouettes poorly last frame):
     // half the particles restart from default poses where the hull is,
     // facing the screen (thesis 6.6: recovery within 2-3 frames).
@@ -384,7 +412,23 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     };
     const double span = (window - 4) * dt;
     velocity_xy_ = (median_of(recent_roots_.size() - 5) - median_of(0)) / span;
-    walking_ = velocity_xy_.norm() > options_.walking_speed_mps;
+    // A walk is steady: the root advances along the walking direction over
+    // at least three quarters of the window's 3-frame steps (a root that
+    // jumps for a few frames — a shadow or a raised arm joining the legs'
+    // voxels — does not).
+    bool steady = false;
+    if (velocity_xy_.norm() > options_.walking_speed_mps) {
+      const Vector2d dir = velocity_xy_.normalized();
+      int ahead = 0, steps = 0;
+      for (size_t i = 0; i + 3 < recent_roots_.size(); ++i, ++steps) {
+        ahead += (recent_roots_[i + 3] - recent_roots_[i]).dot(dir) > 0.01;
+      }
+      steady = steps > 0 && ahead >= 0.75 * steps;
+    }
+    moving_frames_ = steady ? moving_frames_ + 1 : 0;
+    walking_ = moving_frames_ >= 2;
+  } else {
+    moving_frames_ = 0;
   }
 
   std::vector<BodyPose> proposed;

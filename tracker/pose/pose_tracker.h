@@ -38,6 +38,9 @@ struct PoseTrackerOptions {
   double p_body_position = 0.10;
   double p_arm_direction = 0.12;
   double p_default_pose = 0.08;
+  // Share of particles turned half way round with their arms swapped
+  // (FlippedPose), tried before the proposals above.
+  double p_flip = 0.03;
   // Random-walk noise per frame at 30 fps (scaled by sqrt(dt * 30)).
   double sigma_position_m = 0.02;
   double sigma_yaw_rad = 0.06;
@@ -56,7 +59,7 @@ struct PoseTrackerOptions {
   // otherwise mostly face the screen. They only decide between hypotheses the
   // silhouettes cannot tell apart (front and back look alike).
   double walking_heading_prior = 5.0;
-  double screen_heading_prior = 1.5;
+  double screen_heading_prior = 4.0;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
@@ -93,6 +96,10 @@ struct PoseEstimate {
 // Extra proposals, e.g. from posture recognition (thesis 6.3.2, "Shape
 // Descriptor & Posture Recognition Function"): poses to seed particles with.
 using PoseProposalHook = std::function<std::vector<BodyPose>(const FrameFeatures&, const BodyShape&)>;
+
+// The front/back twin of `pose`: turned by pi about z, the arms swapped and
+// mirrored, so that its silhouettes are nearly those of `pose`.
+BodyPose FlippedPose(const BodyPose& pose);
 
 class PoseTracker {
  public:
@@ -140,6 +147,7 @@ class PoseTracker {
   std::deque<Eigen::Vector2d> recent_roots_;
   Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();
   bool walking_ = false;
+  int moving_frames_ = 0;
   bool lost_ = false;
 };
 
