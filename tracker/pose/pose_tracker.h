@@ -103,8 +103,9 @@ BodyPose FlippedPose(const BodyPose& pose);
 
 class PoseTracker {
  public:
-  // `facing`: the direction users face when they enter (towards the screen,
-  // from the surveyed screen geometry), world xy.
+  // `screens` (as surveyed, calib/screens.json) give the pointing targets
+  // and the heading users mostly face (towards the screens' centre); may be
+  // empty (then +y).
   PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface> screens, const PoseTrackerOptions& options);
 
   // One frame-set: `dt` seconds after the previous one.
