@@ -349,11 +349,24 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     }
     next.dof[kDofRightShoulderTwist] = next.dof[kDofLeftShoulderTwist] = 0.0;
   } else if (choice < options_.p_random_walk + options_.p_body_position) {
-    // Body position from the voxel hull (thesis 6.3.2); while the user walks,
-    // the heading from the hull's motion (people face where they walk).
+    // Body position (thesis 6.3.2): the x and y of a random 3D torso axis
+    // point (the waist stands under the torso's axis), else the voxel hull's
+    // root; while the user walks, the heading from the hull's motion (people
+    // face where they walk).
     if (walking_) next.dof[kDofYaw] = YawFacing(velocity_xy_.normalized()) + 0.1 * n01(rng_);
-    PlaceRoot(shape_, &next, features.placement->root.head<2>() +
-                                 Vector2d(0.02 * n01(rng_), 0.02 * n01(rng_)));
+    std::vector<Vector2d> torso;
+    for (const AxisPoint3d& a : features.axis3d) {
+      if (a.part == BodyPart::kTorso) torso.push_back(a.p_in_world.head<2>());
+    }
+    const Vector2d noise(0.02 * n01(rng_), 0.02 * n01(rng_));
+    if (!torso.empty()) {
+      std::uniform_int_distribution<size_t> pick(0, torso.size() - 1);
+      const Vector2d xy = torso[pick(rng_)] + noise;
+      next.dof[kDofX] = xy.x();
+      next.dof[kDofY] = xy.y();
+    } else {
+      PlaceRoot(shape_, &next, features.placement->root.head<2>() + noise);
+    }
   } else if (choice < options_.p_random_walk + options_.p_body_position + options_.p_arm_direction) {
     next = ArmDirectionProposal(current, features);
   } else {
