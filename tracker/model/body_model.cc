@@ -18,12 +18,6 @@ constexpr double kNeckMaxZenith = 40.0 * M_PI / 180.0;
 // Zenith 180 deg (an arm straight up) has no unique swing; stay just short.
 constexpr double kMaxZenith = 178.0 * M_PI / 180.0;
 
-double WrapAngle(double a) {
-  a = std::fmod(a + M_PI, 2 * M_PI);
-  if (a < 0) a += 2 * M_PI;
-  return a - M_PI;
-}
-
 bool ClampRange(double* v, double lo, double hi) {
   if (*v >= lo && *v <= hi) return true;
   *v = std::clamp(*v, lo, hi);
@@ -39,6 +33,12 @@ const Vector3d kDown(0, 0, -1);
 const Vector3d kUp(0, 0, 1);
 
 }  // namespace
+
+double WrapAngle(double a) {
+  a = std::fmod(a + M_PI, 2 * M_PI);
+  if (a < 0) a += 2 * M_PI;
+  return a - M_PI;
+}
 
 const char* BodySegmentName(int segment) {
   static const char* names[] = {"lower_body",      "upper_body",     "head",          "right_upper_arm",

@@ -131,6 +131,9 @@ struct PosedBody {
 // Forward kinematics (thesis 6.1).
 PosedBody PoseBody(const BodyShape& shape, const BodyPose& pose);
 
+// `a` wrapped to [-pi, pi), radians.
+double WrapAngle(double a);
+
 // ZXY Euler angles: Rz(z) * Rx(x) * Ry(y).
 Eigen::Matrix3d RotationZxy(double z, double x, double y);
 // Unit direction of (azimuth, zenith) in a segment's parent frame; `rest` is

@@ -91,6 +91,11 @@ cv::Mat Overlay(const cv::Mat& frame, const CameraFeatures& f, const AxisView* v
   return out;
 }
 
+// A world point as JSON, to 0.1 mm.
+nlohmann::json Rounded(const Eigen::Vector3d& p) {
+  return {std::round(p.x() * 1e4) / 1e4, std::round(p.y() * 1e4) / 1e4, std::round(p.z() * 1e4) / 1e4};
+}
+
 const char* Part3dName(BodyPart part) {
   switch (part) {
     case BodyPart::kHead: return "head";
@@ -219,8 +224,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     }
     nlohmann::json axis3d = nlohmann::json::array();
     for (const AxisPoint3d& a : features.axis3d) {
-      axis3d.push_back({{"p", {std::round(a.p_in_world.x() * 1e4) / 1e4, std::round(a.p_in_world.y() * 1e4) / 1e4,
-                               std::round(a.p_in_world.z() * 1e4) / 1e4}},
+      axis3d.push_back({{"p", Rounded(a.p_in_world)},
                         {"part", Part3dName(a.part)},
                         {"diameter_m", std::round(a.diameter_m * 1e4) / 1e4},
                         {"support", a.support}});
@@ -244,10 +248,6 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     const bool tracking = pose ? pose->tracking : features.placement.has_value();
     // "partial": someone is there but not yet (or no longer) in every view.
     track_line["state"] = tracking ? "tracking" : (pose && features.placement && !pose->in_view) ? "partial" : "empty";
-    auto rounded = [](const Eigen::Vector3d& p) {
-      return nlohmann::json{std::round(p.x() * 1e4) / 1e4, std::round(p.y() * 1e4) / 1e4,
-                            std::round(p.z() * 1e4) / 1e4};
-    };
     nlohmann::json joints = nlohmann::json::object();
     for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
                              "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
@@ -257,7 +257,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
     track_line["height_m"] = nullptr;
     if (pose && pose->tracking) {
-      for (int j = 0; j < kModelJointCount; ++j) joints[ModelJointName(j)] = rounded(pose->body.joints[j]);
+      for (int j = 0; j < kModelJointCount; ++j) joints[ModelJointName(j)] = Rounded(pose->body.joints[j]);
       nlohmann::json dof = nlohmann::json::object();
       for (int d = 0; d < kDofCount; ++d) dof[BodyDofName(d)] = std::round(pose->pose.dof[d] * 1e5) / 1e5;
       track_line["dof"] = dof;
@@ -266,7 +266,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
         const auto& ray = pose->pointing[side];
         nlohmann::json j = nullptr;
         if (ray) {
-          j = {{"origin", rounded(ray->origin)}, {"dir", rounded(ray->dir)}, {"screen", nullptr},
+          j = {{"origin", Rounded(ray->origin)}, {"dir", Rounded(ray->dir)}, {"screen", nullptr},
                {"screen_hit", nullptr}, {"target", nullptr}};
           if (ray->screen_hit) {
             j["screen"] = *ray->screen;

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <random>
+#include <unistd.h>
 
 #include "common/error.h"
 #include "sim/camera/rig.h"
@@ -250,6 +252,12 @@ TEST(RestState, LearnsTheRestRuleFromSamples) {
   int correct = 0;
   for (size_t i = 0; i < test_x.size(); ++i) correct += svm.AtRest(test_x[i]) == (test_y[i] == 1);
   EXPECT_GT(correct / double(test_x.size()), 0.92);
+  // Saved and loaded, it decides the same.
+  const auto file = std::filesystem::temp_directory_path() / ("rest_svm_test_" + std::to_string(getpid()) + ".yml");
+  svm.Save(file);
+  const RestClassifier loaded = RestClassifier::Load(file);
+  for (const auto& f : test_x) EXPECT_EQ(loaded.AtRest(f), svm.AtRest(f));
+  std::filesystem::remove(file);
 }
 
 TEST(RestState, TheShippedModelLoadsAndKnowsHangingFromPointing) {

@@ -16,17 +16,14 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-double WrapAngle(double a) {
-  a = std::fmod(a + M_PI, 2 * M_PI);
-  if (a < 0) a += 2 * M_PI;
-  return a - M_PI;
-}
-
 bool IsAngleDof(int d) { return d >= kDofYaw; }
 
 double Millis(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
+
+// The yaw (DOF 3) of a body facing unit direction `dir` (world xy).
+double YawFacing(const Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
 
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -42,6 +39,7 @@ void PoseTrackerOptions::Check() const {
   for (double p : {p_random_walk, p_body_position, p_arm_direction, p_default_pose}) {
     if (!(p >= 0)) throw std::invalid_argument("pose proposal probabilities must be non-negative");
   }
+  if (!(p_flip >= 0 && p_flip <= 1)) throw std::invalid_argument("pose.p_flip must be in [0, 1]");
   if (!(p_random_walk + p_body_position + p_arm_direction + p_default_pose > 0)) {
     throw std::invalid_argument("pose proposal probabilities must not all be zero");
   }
@@ -98,10 +96,7 @@ bool PoseTracker::InView(const Eigen::Vector3d& root) const {
 }
 
 double PoseTracker::HeadingPrior(const BodyPose& pose) const {
-  auto away = [&](const Vector2d& dir) {
-    const double yaw = std::atan2(-dir.x(), dir.y());
-    return (1.0 - std::cos(pose.dof[kDofYaw] - yaw)) / 2;
-  };
+  auto away = [&](const Vector2d& dir) { return (1.0 - std::cos(pose.dof[kDofYaw] - YawFacing(dir))) / 2; };
   if (walking_) return -options_.walking_heading_prior * away(velocity_xy_.normalized());
   return -options_.screen_heading_prior * away(facing_xy_);
 }
@@ -128,8 +123,6 @@ void PlaceRoot(const BodyShape& shape, BodyPose* pose, const Vector2d& root_xy) 
   pose->dof[kDofX] += offset.x();
   pose->dof[kDofY] += offset.y();
 }
-
-double YawFacing(const Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
 
 }  // namespace
 
@@ -169,37 +162,42 @@ void PoseTracker::Scatter() {
   previous_ = particles_;
 }
 
-namespace {
-
 // The 3D arm axis points split into chains (single linkage within
-// `link_m`); each chain belongs to the shoulder nearest its nearest point, so
-// an arm reaching across the body stays with the shoulder it starts from.
-std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<AxisPoint3d>& axis3d,
-                                                     const Vector3d& right_shoulder, const Vector3d& left_shoulder,
-                                                     double link_m = 0.08) {
-  std::vector<Vector3d> points;
+// `link_m`), one per seen arm; once per frame.
+PoseTracker::ArmChains PoseTracker::ChainArmPoints(const std::vector<AxisPoint3d>& axis3d, double link_m) {
+  ArmChains out;
   for (const AxisPoint3d& a : axis3d) {
-    if (a.part == BodyPart::kArm) points.push_back(a.p_in_world);
+    if (a.part == BodyPart::kArm) out.points.push_back(a.p_in_world);
   }
-  const int n = static_cast<int>(points.size());
-  std::vector<int> chain(n, -1);
-  int chains = 0;
+  const int n = static_cast<int>(out.points.size());
+  out.chain.assign(n, -1);
   for (int seed = 0; seed < n; ++seed) {
-    if (chain[seed] >= 0) continue;
+    if (out.chain[seed] >= 0) continue;
     std::vector<int> stack = {seed};
-    chain[seed] = chains;
+    out.chain[seed] = out.count;
     while (!stack.empty()) {
       const int i = stack.back();
       stack.pop_back();
       for (int j = 0; j < n; ++j) {
-        if (chain[j] < 0 && (points[i] - points[j]).norm() < link_m) {
-          chain[j] = chains;
+        if (out.chain[j] < 0 && (out.points[i] - out.points[j]).norm() < link_m) {
+          out.chain[j] = out.count;
           stack.push_back(j);
         }
       }
     }
-    ++chains;
+    ++out.count;
   }
+  return out;
+}
+
+namespace {
+
+// Each chain belongs to the shoulder nearest its nearest point, so an arm
+// reaching across the body stays with the shoulder it starts from.
+std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<Vector3d>& points, const std::vector<int>& chain,
+                                                     int chains, const Vector3d& right_shoulder,
+                                                     const Vector3d& left_shoulder) {
+  const int n = static_cast<int>(points.size());
   std::array<std::vector<Vector3d>, 2> out;
   for (int c = 0; c < chains; ++c) {
     double best_right = 1e9, best_left = 1e9;
@@ -221,7 +219,8 @@ std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<AxisPoint
 BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& features) {
   const PosedBody body = PoseBody(shape_, pose);
   std::normal_distribution<double> jitter(0.0, 0.05);
-  const auto by_side = ArmPointsBySide(features.axis3d, body.frames[kRightUpperArm].translation(),
+  const auto by_side = ArmPointsBySide(arm_chains_.points, arm_chains_.chain, arm_chains_.count,
+                                       body.frames[kRightUpperArm].translation(),
                                        body.frames[kLeftUpperArm].translation());
   for (int arm : {kRightUpperArm, kLeftUpperArm}) {
     const Vector3d shoulder = body.frames[arm].translation();
@@ -354,14 +353,10 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     // root; while the user walks, the heading from the hull's motion (people
     // face where they walk).
     if (walking_) next.dof[kDofYaw] = YawFacing(velocity_xy_.normalized()) + 0.1 * n01(rng_);
-    std::vector<Vector2d> torso;
-    for (const AxisPoint3d& a : features.axis3d) {
-      if (a.part == BodyPart::kTorso) torso.push_back(a.p_in_world.head<2>());
-    }
     const Vector2d noise(0.02 * n01(rng_), 0.02 * n01(rng_));
-    if (!torso.empty()) {
-      std::uniform_int_distribution<size_t> pick(0, torso.size() - 1);
-      const Vector2d xy = torso[pick(rng_)] + noise;
+    if (!torso_xy_.empty()) {
+      std::uniform_int_distribution<size_t> pick(0, torso_xy_.size() - 1);
+      const Vector2d xy = torso_xy_[pick(rng_)] + noise;
       next.dof[kDofX] = xy.x();
       next.dof[kDofY] = xy.y();
     } else {
@@ -396,7 +391,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   std::vector<IcpView> icp_views;
   for (size_t c = 0; c < cameras_.size(); ++c) {
     views.emplace_back(cameras_[c], features.cameras[c].silhouette, map1_[c], map2_[c], options_.observation.scale);
-    if (options_.refine_fraction > 0) {
+    if (options_.refine_fraction > 0 && options_.icp.iterations > 0) {
       icp_views.push_back({cameras_[c], projections_[c], OutlinePolygons(views.back().ideal_silhouette())});
     }
   }
@@ -442,6 +437,13 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     walking_ = moving_frames_ >= 2;
   } else {
     moving_frames_ = 0;
+  }
+
+  // What the proposals read of the 3D axis points, once per frame.
+  arm_chains_ = ChainArmPoints(features.axis3d);
+  torso_xy_.clear();
+  for (const AxisPoint3d& a : features.axis3d) {
+    if (a.part == BodyPart::kTorso) torso_xy_.push_back(a.p_in_world.head<2>());
   }
 
   std::vector<BodyPose> proposed;

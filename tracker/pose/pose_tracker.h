@@ -146,6 +146,15 @@ class PoseTracker {
   std::vector<double> heights_, girths_;
   std::vector<BodyPose> particles_, previous_;
   std::deque<Eigen::Vector2d> recent_roots_;
+  // This frame's 3D arm axis points in chains, and torso axis points (x, y).
+  struct ArmChains {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<int> chain;  // per point
+    int count = 0;
+  };
+  static ArmChains ChainArmPoints(const std::vector<AxisPoint3d>& axis3d, double link_m = 0.08);
+  ArmChains arm_chains_;
+  std::vector<Eigen::Vector2d> torso_xy_;
   Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();
   bool walking_ = false;
   int moving_frames_ = 0;

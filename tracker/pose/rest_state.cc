@@ -117,9 +117,12 @@ RestClassifier RestClassifier::Load(const std::filesystem::path& path) {
 
 void RestClassifier::Save(const std::filesystem::path& path) const {
   if (empty()) throw std::logic_error("saving an untrained rest classifier");
-  const std::string temp = path.string() + ".partial.yml";
-  impl_->svm->save(temp);
-  std::filesystem::rename(temp, path);
+  // What cv::ml::SVM::save writes, through the project's atomic writer.
+  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  fs << impl_->svm->getDefaultName() << "{";
+  impl_->svm->write(fs);
+  fs << "}";
+  AtomicWriteFile(path, fs.releaseAndGetString());
 }
 
 bool RestClassifier::AtRest(const std::array<float, 6>& features) const {
