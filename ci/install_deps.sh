@@ -13,6 +13,8 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev libtinygltf-dev
+  gnuplot-nox   # the report's plots (irbench score)
+  chromium      # the report's test opens it in headless Chromium
 )
 
 missing=()

@@ -16,6 +16,7 @@
 #include "sim/sequence/render_job.h"
 #include "ci/demo/demo_job.h"
 #include "ci/score/score.h"
+#include "ci/score/score_job.h"
 #include "ci/suite/suite.h"
 #include "tracker/pipeline/track_job.h"
 #include "ci/train/rest_training.h"
@@ -127,7 +128,7 @@ int main(int argc, char** argv) {
   int demo_frames = 0;
   CLI::App* demo_cmd = app.add_subcommand(
       "demo", "The main job: render the default session (theater4, thesis preset, about 20 s),\n"
-              "run the tracker, score it against the truth, print the tables");
+              "run the tracker, score it against the truth, print the tables and write report.html");
   demo_cmd->add_option("--out", demo_out, "sequence folder, track/ and score/ go inside (default: renders/demo)");
   demo_cmd->add_option("--avatar", demo.avatar, "avatar name (avatars/) or file")->capture_default_str();
   demo_cmd->add_option("--motion", demo.motion, "motion, as for render --motion")->capture_default_str();
@@ -154,13 +155,18 @@ int main(int argc, char** argv) {
   std::string score_sequence, score_track, score_out;
   CLI::App* score_cmd = app.add_subcommand(
       "score", "Score a track file against the sequence's truth: the thesis's tables (joint errors with\n"
-               "Chauvenet outliers, pointing angles, rest state, motion labels) as JSON, Markdown and CSV");
+               "Chauvenet outliers, pointing angles, rest state, motion labels) as JSON, Markdown and CSV,\n"
+               "and report.html: the tables, plots and a frame viewer with the truth and the track drawn over\n"
+               "every camera's image, worst frames first");
   score_cmd->add_option("SEQ", score_sequence, "sequence folder written by render")->required();
   score_cmd->add_option("--track", score_track, "track.jsonl to score (default: SEQ/track/track.jsonl)");
   score_cmd->add_option("--out", score_out, "output folder (default: SEQ/score)");
   score_cmd->add_flag("--include-rest-arms", score.score.include_rest_arms,
                       "also score elbows and wrists of arms at rest (the thesis leaves them out)");
   score_cmd->add_flag("--force", score.overwrite, "replace an existing output folder");
+  bool score_no_report = false;
+  score_cmd->add_flag("--no-report", score_no_report,
+                      "skip report.html (tables, gnuplot plots, frame viewer; opens offline in a browser)");
 
   // motion
   CLI::App* motion_cmd = app.add_subcommand("motion", "List, inspect and export motions");
@@ -287,7 +293,8 @@ int main(int argc, char** argv) {
       std::cout << r.tables << "\n"
                 << "sequence  " << r.sequence.string() << "\n"
                 << "track     " << r.track.string() << "\n"
-                << "score     " << r.score.string() << "\n";
+                << "score     " << r.score.string() << "\n"
+                << "report    " << (r.score / "report.html").string() << "  (open in a browser)\n";
       return kExitOk;
     }
     if (suite_run->parsed()) {
@@ -308,9 +315,12 @@ int main(int argc, char** argv) {
       score.sequence = score_sequence;
       score.track = score_track;
       score.out = score_out;
+      score.report = !score_no_report;
       std::string tables;
       const std::filesystem::path folder = irbench::RunScoreJob(score, &tables);
-      std::cout << tables << "\n" << folder.string() << "\n";
+      std::cout << tables << "\n";
+      if (score.report) std::cout << "report  " << (folder / "report.html").string() << "\n";
+      std::cout << folder.string() << "\n";
       return kExitOk;
     }
     if (avatar_list->parsed()) {

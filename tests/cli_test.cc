@@ -388,6 +388,7 @@ TEST(CliTest, ScorePrintsTheTablesAndRefusesBadInput) {
   EXPECT_NE(r.out.find("| Waist | 0.00 |"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(dir / "seq/score/score.json"));
   EXPECT_TRUE(fs::exists(dir / "seq/score/errors.csv"));
+  EXPECT_TRUE(fs::exists(dir / "seq/score/report.html"));
   WriteText(dir / "bad.jsonl", "{\"frame\": 0, \"joints3d\": {\"root\": \"here\"}}\n");
   for (const auto& [args, expected] :
        {std::pair<std::vector<std::string>, std::string>{{"score", (dir / "seq").string(), "--track",
@@ -409,7 +410,7 @@ TEST(CliTest, DemoRendersTracksAndScores) {
   const Result r = RunIrbench({"demo", "--frames", "8", "--out", (dir / "demo").string()}, dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("| Joint | Mean | Std | Outliers | Total | Missing |"), std::string::npos) << r.out;
-  for (const char* file : {"manifest.json", "track/track.jsonl", "track/features.jsonl", "score/score.json",
+  for (const char* file : {"manifest.json", "track/track.jsonl", "track/features.jsonl", "score/score.json", "score/report.html",
                            "score/tables.md"}) {
     EXPECT_TRUE(fs::exists(dir / "demo" / file)) << file;
   }

@@ -1,6 +1,7 @@
 #include "ci/demo/demo_job.h"
 
 #include "ci/score/score.h"
+#include "ci/score/score_job.h"
 #include "common/logging.h"
 #include "common/paths.h"
 #include "sim/sequence/render_job.h"

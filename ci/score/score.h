@@ -76,17 +76,4 @@ struct Score {
 Score ScoreTrack(const std::filesystem::path& truth_jsonl, const std::filesystem::path& track_jsonl,
                  const ScoreOptions& options = {});
 
-struct ScoreJobOptions {
-  std::filesystem::path sequence;
-  std::filesystem::path track;  // default: <sequence>/track/track.jsonl
-  std::filesystem::path out;    // default: <sequence>/score
-  bool overwrite = false;
-  ScoreOptions score;
-};
-
-// `irbench score`: writes score.json, tables.md, joints.csv (per-joint
-// summary), errors.csv (per frame and joint/hand) into `out` (complete or not
-// at all). Returns the folder; `summary` (if given) receives the Markdown.
-std::filesystem::path RunScoreJob(const ScoreJobOptions& options, std::string* summary = nullptr);
-
 }  // namespace irbench

@@ -3,6 +3,7 @@
 // criterion must remove exactly the injected outliers.
 
 #include "ci/score/score.h"
+#include "ci/score/score_job.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

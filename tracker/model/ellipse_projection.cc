@@ -119,4 +119,24 @@ std::vector<Vector3d> EllipsoidRim(const Ellipsoid& ellipsoid, const Vector3d& c
   return out;
 }
 
+std::vector<std::vector<Eigen::Vector2d>> BodyOutlines(const Camera& camera, const PosedBody& body, int count) {
+  const Eigen::Matrix<double, 3, 4> P = ProjectionMatrix(camera);
+  const Eigen::Matrix3d K_inv = camera.K().inverse();
+  const Eigen::Vector3d center = camera.CenterInWorld();
+  std::vector<std::vector<Eigen::Vector2d>> out;
+  for (const Ellipsoid& segment : body.segments) {
+    const std::optional<ImageEllipse> e = ProjectEllipsoid(P, center, segment);
+    if (!e) continue;
+    std::vector<Eigen::Vector2d> ideal;
+    e->Contour(count, &ideal, nullptr);
+    std::vector<Eigen::Vector2d>& outline = out.emplace_back();
+    for (const Eigen::Vector2d& p : ideal) {
+      const Eigen::Vector3d n = K_inv * p.homogeneous();
+      const Eigen::Vector2d d = camera.Distort(n.head<2>() / n.z());
+      outline.emplace_back(camera.fx * d.x() + camera.cx, camera.fy * d.y() + camera.cy);
+    }
+  }
+  return out;
+}
+
 }  // namespace irbench

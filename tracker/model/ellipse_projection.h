@@ -56,4 +56,10 @@ std::optional<ImageEllipse> ProjectEllipsoid(const Eigen::Matrix<double, 3, 4>& 
 std::vector<Eigen::Vector3d> EllipsoidRim(const Ellipsoid& ellipsoid, const Eigen::Vector3d& camera_center_world,
                                           int count);
 
+// The posed body's segment outlines as the camera's real (distorted) image
+// shows them: each segment's analytic outline, `count` points, taken from
+// ideal pixels through the camera's lens distortion. What overlays and the
+// report draw; segments with no elliptic outline are left out.
+std::vector<std::vector<Eigen::Vector2d>> BodyOutlines(const Camera& camera, const PosedBody& body, int count);
+
 }  // namespace irbench

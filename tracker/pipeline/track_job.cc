@@ -43,20 +43,11 @@ cv::Scalar PartColour(BodyPart part) {
   }
 }
 
-// The model's ellipse outlines, from ideal pixels to the camera's distorted
-// image.
+// The model's ellipse outlines in the camera's distorted image.
 void DrawModel(cv::Mat* out, const Camera& camera, const PosedBody& body) {
-  const auto P = ProjectionMatrix(camera);
-  const Eigen::Matrix3d K_inv = camera.K().inverse();
-  for (const ImageEllipse& e : ProjectBody(camera, P, body)) {
-    std::vector<Eigen::Vector2d> ideal;
-    e.Contour(48, &ideal, nullptr);
+  for (const std::vector<Eigen::Vector2d>& outline : BodyOutlines(camera, body, 48)) {
     std::vector<cv::Point> poly;
-    for (const Eigen::Vector2d& p : ideal) {
-      const Eigen::Vector3d n = K_inv * p.homogeneous();
-      const Eigen::Vector2d d = camera.Distort(n.head<2>() / n.z());
-      poly.emplace_back(int(std::lround(camera.fx * d.x() + camera.cx)), int(std::lround(camera.fy * d.y() + camera.cy)));
-    }
+    for (const Eigen::Vector2d& p : outline) poly.emplace_back(int(std::lround(p.x())), int(std::lround(p.y())));
     cv::polylines(*out, poly, true, cv::Scalar(0, 140, 255), 1, cv::LINE_AA);
   }
 }

@@ -1,0 +1,33 @@
+#pragma once
+// The report's pictures, drawn by gnuplot (Debian's gnuplot-nox) as SVG: the
+// per-joint error histograms of the thesis's Fig. 6.8 and the errors over
+// time. irbench writes the data and a gnuplot script; gnuplot draws.
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "ci/score/score.h"
+
+namespace irbench {
+
+// The gnuplot to run: $IRBENCH_GNUPLOT when set (a path; empty means "no
+// gnuplot"), otherwise `gnuplot` found on PATH. nullopt when there is none.
+std::optional<std::filesystem::path> FindGnuplot();
+
+// Runs `gnuplot script_file` in `workdir`. Throws RuntimeError with what
+// gnuplot printed when it fails.
+void RunGnuplot(const std::filesystem::path& gnuplot, const std::filesystem::path& workdir,
+                const std::string& script_file);
+
+// Draws the score's plots with `gnuplot` in `workdir` (created if needed):
+// returns plot name -> SVG text for "joint_histograms" (Fig. 6.8: one panel
+// per joint, Chauvenet outliers left out and counted in the panel's title)
+// and "errors_over_time" (joint errors in cm and pointing errors in degrees
+// against the frame; gaps where nothing was scored). The data and script
+// stay in `workdir` so that a user can restyle them.
+std::map<std::string, std::string> DrawScorePlots(const Score& score, const std::filesystem::path& gnuplot,
+                                                  const std::filesystem::path& workdir);
+
+}  // namespace irbench
