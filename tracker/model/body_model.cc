@@ -34,6 +34,8 @@ const Vector3d kUp(0, 0, 1);
 
 }  // namespace
 
+double YawFacing(const Eigen::Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
+
 double WrapAngle(double a) {
   a = std::fmod(a + M_PI, 2 * M_PI);
   if (a < 0) a += 2 * M_PI;

@@ -134,6 +134,10 @@ PosedBody PoseBody(const BodyShape& shape, const BodyPose& pose);
 // `a` wrapped to [-pi, pi), radians.
 double WrapAngle(double a);
 
+// The body yaw (DOF 3) of a body facing the unit direction `dir` (world xy;
+// yaw 0 faces +y).
+double YawFacing(const Eigen::Vector2d& dir);
+
 // ZXY Euler angles: Rz(z) * Rx(x) * Ry(y).
 Eigen::Matrix3d RotationZxy(double z, double x, double y);
 // Unit direction of (azimuth, zenith) in a segment's parent frame; `rest` is

@@ -103,3 +103,23 @@ TEST(BodyModel, JointLimitsKeepAllowedPosesAndCapTheRest) {
 
 }  // namespace
 }  // namespace irbench
+
+namespace irbench {
+namespace {
+
+// YawFacing turns the body to face a direction: the person's right shoulder
+// is then on their right (facing = up x (right - left)).
+TEST(BodyModel, YawFacingFacesTheDirection) {
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  for (double a = -3.0; a < 3.2; a += 0.5) {
+    const Eigen::Vector2d dir(std::cos(a), std::sin(a));
+    const PosedBody body = PoseBody(shape, StandingPose(shape, Eigen::Vector2d(0.3, -0.2), YawFacing(dir)));
+    const Eigen::Vector3d across = body.joints[kModelRightShoulder] - body.joints[kModelLeftShoulder];
+    const Eigen::Vector3d facing = Eigen::Vector3d::UnitZ().cross(across).normalized();
+    EXPECT_NEAR(facing.x(), dir.x(), 1e-9) << a;
+    EXPECT_NEAR(facing.y(), dir.y(), 1e-9) << a;
+  }
+}
+
+}  // namespace
+}  // namespace irbench

@@ -22,9 +22,6 @@ double Millis(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
 
-// The yaw (DOF 3) of a body facing unit direction `dir` (world xy).
-double YawFacing(const Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
-
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -54,6 +51,7 @@ void PoseTrackerOptions::Check() const {
   }
   if (!(min_overlap >= 0 && min_overlap <= 1)) throw std::invalid_argument("pose.min_overlap must be in [0, 1]");
   if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
+  if (!(walk_memory_s >= 0)) throw std::invalid_argument("pose.walk_memory_s must be non-negative");
 }
 
 PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface> screens,
@@ -98,6 +96,10 @@ bool PoseTracker::InView(const Eigen::Vector3d& root) const {
 double PoseTracker::HeadingPrior(const BodyPose& pose) const {
   auto away = [&](const Vector2d& dir) { return (1.0 - std::cos(pose.dof[kDofYaw] - YawFacing(dir))) / 2; };
   if (walking_) return -options_.walking_heading_prior * away(velocity_xy_.normalized());
+  if (walk_memory_ > 0) {
+    const Vector2d blend = walk_memory_ * walk_dir_ + (1 - walk_memory_) * facing_xy_;
+    if (blend.norm() > 1e-3) return -options_.screen_heading_prior * away(blend.normalized());
+  }
   return -options_.screen_heading_prior * away(facing_xy_);
 }
 
@@ -139,6 +141,14 @@ void PoseTracker::Initialise(const FrameFeatures& features) {
   // has just walked in is heading.
   const Vector2d to_centre = -root;
   const double yaw_centre = to_centre.norm() > 0.5 ? YawFacing(to_centre.normalized()) : YawFacing(to_screen);
+  // First seen half in view: entering, heading for the centre.
+  walk_memory_ = 0;
+  entering_ = false;
+  if (!InView(place.root) && to_centre.norm() > 0.5) {
+    walk_dir_ = to_centre.normalized();
+    walk_memory_ = 1;
+    entering_ = true;
+  }
   for (int i = 0; i < options_.particles; ++i) {
     const double yaw = (i % 4 < 2 ? YawFacing(to_screen) : yaw_centre) + yaw_noise(rng_);
     BodyPose p = (i % 2 == 0) ? StandingPose(shape_, root, yaw) : ScarecrowPose(shape_, root, yaw);
@@ -370,8 +380,10 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
   // While the user walks, a particle facing more than 90 deg away from the
   // walking direction is turned to it (people do not walk backwards onto a
   // stage; silhouettes cannot tell front from back).
-  if (walking_) {
-    const double heading = YawFacing(velocity_xy_.normalized());
+  // An entering user (first seen half in view) likewise faces the stage's
+  // centre until the walk itself is seen.
+  if (walking_ || entering_) {
+    const double heading = YawFacing(walking_ ? velocity_xy_.normalized() : walk_dir_);
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next.dof[kDofYaw] = heading + 0.1 * n01(rng_);
   }
   ClampToJointLimits(&next);
@@ -438,6 +450,13 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   } else {
     moving_frames_ = 0;
   }
+  if (walking_) {
+    walk_dir_ = velocity_xy_.normalized();
+    walk_memory_ = 1;
+  } else if (active_) {
+    walk_memory_ = std::max(0.0, walk_memory_ - dt / std::max(options_.walk_memory_s, 1e-6));
+  }
+  if (walking_ || walk_memory_ < 0.5) entering_ = false;
 
   // What the proposals read of the 3D axis points, once per frame.
   arm_chains_ = ChainArmPoints(features.axis3d);

@@ -60,6 +60,11 @@ struct PoseTrackerOptions {
   // silhouettes cannot tell apart (front and back look alike).
   double walking_heading_prior = 5.0;
   double screen_heading_prior = 4.0;
+  // After a walk, people keep facing about where they walked while they turn
+  // to the screen: for this long the preferred heading blends from the last
+  // walking direction to the screen's (linearly). A user first seen half in
+  // view is entering, heading for the stage's centre: the same memory.
+  double walk_memory_s = 2.0;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
@@ -158,6 +163,13 @@ class PoseTracker {
   Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();
   bool walking_ = false;
   int moving_frames_ = 0;
+  // The last walking direction and how much of it the heading prior still
+  // holds (1 while walking, down to 0 over walk_memory_s).
+  Eigen::Vector2d walk_dir_ = Eigen::Vector2d::UnitX();
+  double walk_memory_ = 0;
+  // First seen half in view and not yet seen walking: particles face the
+  // stage's centre (walk_dir_), as they face a walk's direction.
+  bool entering_ = false;
   bool lost_ = false;
 };
 
