@@ -149,6 +149,8 @@ int main(int argc, char** argv) {
   suite_run->add_flag("--bless", suite.bless, "write this run's figures as the new baseline (on purpose)");
   suite_run->add_option("--baselines", suite_baselines, "baseline folder (default: ci/baselines)");
   suite_run->add_option("--cache", suite_cache, "render cache folder (default: renders/cache)");
+  suite_run->add_option("--jobs", suite.jobs, "scenarios at a time (default: the core count)")
+      ->check(CLI::PositiveNumber);
 
   // score
   irbench::ScoreJobOptions score;

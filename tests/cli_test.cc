@@ -428,7 +428,8 @@ TEST(CliTest, DemoRendersTracksAndScores) {
 
 // The smoke suite passes against the blessed baselines, and fails when the
 // tracker is deliberately degraded (the thesis's plain background model and no
-// shadow removal, under the same suite name and baselines).
+// shadow removal; a 3-particle pose tracker — under the same suite name and
+// baselines).
 TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   const fs::path dir = FreshTempDir("cli_suite");
   const fs::path smoke = fs::path(IRBENCH_SOURCE_DIR) / "ci" / "suites" / "smoke.json";
@@ -448,6 +449,19 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   EXPECT_EQ(bad.exit_code, 1) << bad.out << bad.err;
   EXPECT_NE(bad.out.find("regressed from the baseline"), std::string::npos) << bad.out;
   EXPECT_NE(bad.err.find("suite smoke:"), std::string::npos) << bad.err;
+
+  // A degraded pose tracker (3 particles instead of 100), run two scenarios at
+  // a time: the arms regress.
+  auto few_particles = nlohmann::json::parse(ReadText(smoke));
+  for (auto& scenario : few_particles["scenarios"]) scenario["track"] = {{"particles", 3}};
+  WriteText(dir / "few_particles.json", few_particles.dump(2));
+  const Result weak = RunIrbench({"suite", "run", (dir / "few_particles.json").string(), "--cache",
+                                  (dir / "cache").string(), "--jobs", "2", "--baselines",
+                                  (fs::path(IRBENCH_SOURCE_DIR) / "ci" / "baselines").string()},
+                                 dir);
+  EXPECT_EQ(weak.exit_code, 1) << weak.out << weak.err;
+  EXPECT_NE(weak.out.find("| arms_mean_cm |"), std::string::npos) << weak.out;
+  EXPECT_NE(weak.out.find("regressed from the baseline"), std::string::npos) << weak.out;
 
   // A bad suite file: one line naming the file and field, exit 2.
   WriteText(dir / "typo.json", R"({"format": "irbench.suite/1", "name": "t", "scenarios": [

@@ -43,13 +43,6 @@ std::string Quoted(const std::string& s) {
   return out + "\"";
 }
 
-std::string Title(const std::string& name) {
-  std::string out = name;
-  std::replace(out.begin(), out.end(), '_', ' ');
-  if (!out.empty()) out[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(out[0])));
-  return out;
-}
-
 // One series per file, "frame value" rows; a blank line where frames are
 // skipped so that gnuplot breaks the line there.
 void WriteSeries(const fs::path& path, const std::vector<std::tuple<int, double, bool>>& rows) {
@@ -134,7 +127,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
         }
       }
     }
-    std::string title = Title(joint);
+    std::string title = TitleCase(joint);
     if (outliers) title += " (" + std::to_string(outliers) + " outlier" + (outliers > 1 ? "s" : "") + ")";
     gp << "set title " << Quoted(title) << "\n";
     if (kept.empty()) {
@@ -176,7 +169,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
       const std::string file = prefix + names[i] + ".dat";
       WriteSeries(workdir / file, it->second);
       parts.push_back(Quoted(file) + " using 1:2 with lines lw 1.5 lc rgb \"" + colours[i % 9] + "\" title " +
-                      Quoted(Title(prefix == "time_pointing_" ? names[i] + " hand" : names[i])));
+                      Quoted(TitleCase(prefix == "time_pointing_" ? names[i] + " hand" : names[i])));
     }
     if (parts.empty()) {
       gp << "set label 1 \"not scored\" at graph 0.5, graph 0.5 center\nplot [0:1] [0:1] 2 notitle\nunset label 1\n";

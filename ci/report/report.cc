@@ -87,21 +87,6 @@ std::string Fixed(double v, int digits) {
   return buf;
 }
 
-std::string Title(const std::string& name) {
-  std::string out = name;
-  bool up = true;
-  for (char& c : out) {
-    if (c == '_') {
-      c = ' ';
-      up = true;
-    } else if (up) {
-      c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-      up = false;
-    }
-  }
-  return out;
-}
-
 double Round1(double v) { return std::round(v * 10) / 10; }
 
 std::string StatsRow(const std::string& name, const ErrorStats& s) {
@@ -119,16 +104,16 @@ std::string Tables(const Score& score) {
       "<tr><th></th><th>Mean</th><th>Std</th><th>Outliers</th><th>Total</th><th>Missing</th><th>Max kept</th></tr>\n";
   out << "<h3>Joint errors, cm <small>(thesis Table 6.1; outliers by Chauvenet's criterion)</small></h3>\n"
       << "<table id=\"joints\">" << head;
-  for (const std::string& joint : ScoredJoints()) out << StatsRow(Title(joint), score.joints.at(joint));
+  for (const std::string& joint : ScoredJoints()) out << StatsRow(TitleCase(joint), score.joints.at(joint));
   out << "</table>\n<h3>Pointing errors, degrees <small>(thesis Table 6.3)</small></h3>\n<table id=\"pointing\">"
       << head;
-  for (const std::string side : {"right", "left"}) out << StatsRow(Title(side) + " hand", score.pointing.at(side));
+  for (const std::string side : {"right", "left"}) out << StatsRow(TitleCase(side) + " hand", score.pointing.at(side));
   out << "</table>\n<h3>Rest state <small>(thesis 6.4)</small></h3>\n<table id=\"rest\">"
       << "<tr><th>Arm</th><th>Accuracy</th><th>Frames</th><th>Missing</th></tr>\n";
   for (const std::string side : {"right", "left", "both"}) {
     const auto it = score.rest.find(side);
     const Score::Accuracy a = it == score.rest.end() ? Score::Accuracy{} : it->second;
-    out << "<tr><th>" << Title(side) << "</th><td>" << (a.total ? Fixed(100 * a.rate(), 2) + " %" : "–")
+    out << "<tr><th>" << TitleCase(side) << "</th><td>" << (a.total ? Fixed(100 * a.rate(), 2) + " %" : "–")
         << "</td><td>" << a.total << "</td><td>" << a.missing << "</td></tr>\n";
   }
   out << "</table>\n";

@@ -92,7 +92,10 @@ std::string Fixed(double v, int digits) {
   return buf;
 }
 
-std::string Title(const std::string& joint) {
+
+}  // namespace
+
+std::string TitleCase(const std::string& joint) {
   std::string out;
   bool up = true;
   for (char c : joint) {
@@ -106,8 +109,6 @@ std::string Title(const std::string& joint) {
   }
   return out;
 }
-
-}  // namespace
 
 std::vector<bool> ChauvenetOutliers(const std::vector<double>& samples) {
   const size_t n = samples.size();
@@ -299,7 +300,7 @@ std::string Score::Markdown() const {
       << "| Joint | Mean | Std | Outliers | Total | Missing |\n|---|---|---|---|---|---|\n";
   for (const std::string& joint : ScoredJoints()) {
     const ErrorStats& s = joints.at(joint);
-    out << "| " << Title(joint) << " | " << (s.total ? Fixed(s.mean, 2) : "–") << " | "
+    out << "| " << TitleCase(joint) << " | " << (s.total ? Fixed(s.mean, 2) : "–") << " | "
         << (s.total ? Fixed(s.std, 2) : "–") << " | " << s.outliers << " | " << s.total << " | " << s.missing
         << " |\n";
   }
@@ -307,7 +308,7 @@ std::string Score::Markdown() const {
       << "| Hand | Mean | Std | Outliers | Total | Missing |\n|---|---|---|---|---|---|\n";
   for (const std::string side : {"right", "left"}) {
     const ErrorStats& s = pointing.at(side);
-    out << "| " << Title(side) << " hand | " << (s.total ? Fixed(s.mean, 2) : "–") << " | "
+    out << "| " << TitleCase(side) << " hand | " << (s.total ? Fixed(s.mean, 2) : "–") << " | "
         << (s.total ? Fixed(s.std, 2) : "–") << " | " << s.outliers << " | " << s.total << " | " << s.missing
         << " |\n";
   }
@@ -315,7 +316,7 @@ std::string Score::Markdown() const {
   for (const std::string side : {"right", "left", "both"}) {
     const auto it = rest.find(side);
     const Accuracy a = it == rest.end() ? Accuracy{} : it->second;
-    out << "| " << Title(side) << " | " << (a.total ? Fixed(100 * a.rate(), 2) + "%" : "–") << " | " << a.total
+    out << "| " << TitleCase(side) << " | " << (a.total ? Fixed(100 * a.rate(), 2) + "%" : "–") << " | " << a.total
         << " | " << a.missing << " |\n";
   }
   if (!motion_confusion.empty()) {

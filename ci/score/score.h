@@ -43,6 +43,9 @@ struct ScoreOptions {
   bool include_rest_arms = false;  // score elbows and wrists of arms at rest too
 };
 
+// "right_elbow" -> "Right Elbow": names as the tables print them.
+std::string TitleCase(const std::string& name);
+
 // The nine joints of Table 6.1, in its order.
 const std::vector<std::string>& ScoredJoints();
 

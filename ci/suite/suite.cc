@@ -1,7 +1,12 @@
 #include "ci/suite/suite.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <fstream>
@@ -32,12 +37,25 @@ struct Scenario {
   std::string background_model = "flicker";
   bool remove_shadows = true;
   int hull_missing_views = 0;
+  int particles = 100;
   std::map<std::string, Bound> thresholds;
 };
 
+// The metrics a threshold may name: see suite.h.
 const std::vector<std::string>& KnownMetrics() {
-  static const std::vector<std::string> m = {"silhouette_iou_median", "tracked_fraction", "root_mean_cm"};
+  static const std::vector<std::string> m = [] {
+    std::vector<std::string> out = {"silhouette_iou_median", "tracked_fraction", "arms_mean_cm",
+                                    "pointing_mean_deg", "rest_accuracy"};
+    for (const std::string& joint : ScoredJoints()) out.push_back(joint + "_mean_cm");
+    return out;
+  }();
   return m;
+}
+
+std::string KnownMetricsText() {
+  std::string out;
+  for (const std::string& m : KnownMetrics()) out += (out.empty() ? "" : ", ") + m;
+  return out;
 }
 
 std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
@@ -71,18 +89,20 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
     if (sc.render.background_frames < 2) s["background_frames"].Fail("the tracker needs at least 2");
     if (s.Has("track")) {
       const JsonNode t = s["track"];
-      t.CheckKeys({"background_model", "remove_shadows", "hull_missing_views"});
+      t.CheckKeys({"background_model", "remove_shadows", "hull_missing_views", "particles"});
       sc.background_model = t.GetString("background_model", "flicker");
       if (sc.background_model != "flicker" && sc.background_model != "plain") {
         t["background_model"].Fail("must be flicker or plain");
       }
       sc.remove_shadows = t.Has("remove_shadows") ? t["remove_shadows"].raw().get<bool>() : true;
       sc.hull_missing_views = t.GetInt("hull_missing_views", 0);
+      sc.particles = t.GetInt("particles", 100);
+      if (sc.particles < 1) t["particles"].Fail("must be at least 1");
     }
     const JsonNode th = s["thresholds"];
     for (const auto& [metric, value] : th.raw().items()) {
       if (std::find(KnownMetrics().begin(), KnownMetrics().end(), metric) == KnownMetrics().end()) {
-        th[metric].Fail("unknown metric (silhouette_iou_median, tracked_fraction, root_mean_cm)");
+        th[metric].Fail("unknown metric (" + KnownMetricsText() + ")");
       }
       const JsonNode b = th[metric];
       b.CheckKeys({"max", "min", "tolerance"});
@@ -139,6 +159,68 @@ double MedianSilhouetteIoU(const fs::path& seq, const fs::path& track) {
   return ious[ious.size() / 2];
 }
 
+// What one scenario measured, in the order of its thresholds.
+std::map<std::string, double> RunScenario(const Scenario& sc, const std::string& suite, const fs::path& cache,
+                                          std::mutex* render_mutex) {
+  const auto start = std::chrono::steady_clock::now();
+  // Render, or reuse the cached frames of the same inputs. One render at a
+  // time: each render job owns the process's GL display while it runs.
+  RenderJobOptions render = sc.render;
+  const fs::path seq = cache / (sc.name + "-" + CacheKey(render));
+  {
+    std::lock_guard<std::mutex> lock(*render_mutex);
+    if (!fs::is_regular_file(seq / "manifest.json")) {
+      Log().info("suite {}: {}: rendering", suite, sc.name);
+      render.out = seq;
+      render.overwrite = true;
+      RunRenderJob(render);
+    } else {
+      Log().info("suite {}: {}: rendered before (cache {})", suite, sc.name, seq.filename().string());
+    }
+  }
+  TrackJobOptions track;
+  track.sequence = seq;
+  track.out = seq / ("track-" + sc.background_model + (sc.remove_shadows ? "" : "-shadows") + "-h" +
+                     std::to_string(sc.hull_missing_views) + "-p" + std::to_string(sc.particles));
+  track.background_model = sc.background_model;
+  track.remove_shadows = sc.remove_shadows;
+  track.hull_missing_views = sc.hull_missing_views;
+  track.particles = sc.particles;
+  track.overwrite = true;
+  RunTrackJob(track);
+  const Score score = ScoreTrack(seq / "truth" / "frames.jsonl", track.out / "track.jsonl");
+  std::map<std::string, double> metrics;
+  metrics["silhouette_iou_median"] = MedianSilhouetteIoU(seq, track.out);
+  metrics["tracked_fraction"] = score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
+  double arms = 0;
+  int arm_joints = 0;
+  for (const std::string& joint : ScoredJoints()) {
+    const ErrorStats& e = score.joints.at(joint);
+    if (e.total == 0) continue;
+    metrics[joint + "_mean_cm"] = e.mean;
+    if (joint.find("shoulder") != std::string::npos || joint.find("elbow") != std::string::npos ||
+        joint.find("wrist") != std::string::npos) {
+      arms += e.mean;
+      ++arm_joints;
+    }
+  }
+  if (arm_joints) metrics["arms_mean_cm"] = arms / arm_joints;
+  // Pointing: the kept samples of both hands together.
+  double pointing = 0;
+  int kept = 0;
+  for (const auto& [hand, e] : score.pointing) {
+    pointing += e.mean * (e.total - e.outliers);
+    kept += e.total - e.outliers;
+  }
+  if (kept) metrics["pointing_mean_deg"] = pointing / kept;
+  if (const auto it = score.rest.find("both"); it != score.rest.end() && it->second.total) {
+    metrics["rest_accuracy"] = it->second.rate();
+  }
+  Log().info("suite {}: {}: done in {:.0f} s", suite, sc.name,
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return metrics;
+}
+
 }  // namespace
 
 std::string SuiteResult::Table() const {
@@ -162,36 +244,37 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   if (fs::is_regular_file(baseline_file)) baseline = ParseJsonFile(baseline_file.string()).raw();
   const fs::path cache = options.cache.empty() ? DataRoot() / "renders" / "cache" : options.cache;
   fs::create_directories(cache);
+  // Scenarios in parallel, up to --jobs workers (default: the core count).
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers = std::min<size_t>(scenarios.size(), options.jobs > 0 ? size_t(options.jobs) : cores);
+  Log().info("suite {}: {} scenario(s), {} at a time", result.name, scenarios.size(), workers);
+  std::vector<std::map<std::string, double>> measured(scenarios.size());
+  std::vector<std::exception_ptr> errors(scenarios.size());
+  std::atomic<size_t> next{0};
+  std::mutex render_mutex;
+  const auto work = [&] {
+    for (size_t i; (i = next++) < scenarios.size();) {
+      try {
+        Log().info("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), scenarios[i].name);
+        measured[i] = RunScenario(scenarios[i], result.name, cache, &render_mutex);
+      } catch (...) {
+        errors[i] = std::current_exception();
+        next = scenarios.size();  // start no more
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers; ++w) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+
   nlohmann::json blessed = nlohmann::json::object();
   for (size_t i = 0; i < scenarios.size(); ++i) {
     const Scenario& sc = scenarios[i];
-    Log().info("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), sc.name);
-    // Render, or reuse the cached frames of the same inputs.
-    RenderJobOptions render = sc.render;
-    const fs::path seq = cache / (sc.name + "-" + CacheKey(render));
-    if (!fs::is_regular_file(seq / "manifest.json")) {
-      render.out = seq;
-      render.overwrite = true;
-      RunRenderJob(render);
-    } else {
-      Log().info("suite {}: {} rendered before (cache {})", result.name, sc.name, seq.filename().string());
-    }
-    TrackJobOptions track;
-    track.sequence = seq;
-    track.out = seq / ("track-" + sc.background_model + (sc.remove_shadows ? "" : "-shadows") + "-h" +
-                       std::to_string(sc.hull_missing_views));
-    track.background_model = sc.background_model;
-    track.remove_shadows = sc.remove_shadows;
-    track.hull_missing_views = sc.hull_missing_views;
-    track.overwrite = true;
-    RunTrackJob(track);
-    const Score score = ScoreTrack(seq / "truth" / "frames.jsonl", track.out / "track.jsonl");
-    std::map<std::string, double> metrics;
-    metrics["silhouette_iou_median"] = MedianSilhouetteIoU(seq, track.out);
-    metrics["tracked_fraction"] =
-        score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
-    const ErrorStats& root = score.joints.at("root");
-    if (root.total > 0) metrics["root_mean_cm"] = root.mean;
+    const std::map<std::string, double>& metrics = measured[i];
     for (const auto& [metric, bound] : sc.thresholds) {
       MetricResult r;
       r.scenario = sc.name;

@@ -8,12 +8,21 @@
 // blessed baseline (ci/baselines/<name>.json) within the metric's tolerance.
 // `--bless` writes the baseline from this run on purpose.
 //
-// Metrics (all from the tracker's output against the truth; more as the
-// tracker grows):
+// Scenarios run in parallel, up to `jobs` at a time (default: the core
+// count): renders one at a time (a render job owns the process's GL display),
+// tracking and scoring side by side. Each scenario has its own cache folder,
+// so results do not depend on the order or the number of workers.
+//
+// Metrics (all from the tracker's output against the truth):
 //   silhouette_iou_median   median over camera-frames of the silhouettes' IoU
 //                           with the truth masks (higher is better)
 //   tracked_fraction        frames tracked / frames with the person on stage
-//   root_mean_cm            root error mean, Chauvenet outliers removed
+//   <joint>_mean_cm         a Table 6.1 joint's mean error, Chauvenet outliers
+//                           removed (root, waist, neck, left_/right_shoulder,
+//                           _elbow, _wrist)
+//   arms_mean_cm            the mean of the six arm joints' means
+//   pointing_mean_deg       pointing error, both hands' kept samples (Table 6.3)
+//   rest_accuracy           rest-state agreement, both arms (0..1)
 
 #include <filesystem>
 #include <map>
@@ -27,6 +36,7 @@ struct SuiteRunOptions {
   std::filesystem::path baselines;  // default: <data root>/ci/baselines
   std::filesystem::path cache;      // default: <data root>/renders/cache
   bool bless = false;
+  int jobs = 0;  // scenarios at a time; 0: the core count
 };
 
 struct MetricResult {
