@@ -304,7 +304,8 @@ int main(int argc, char** argv) {
       suite.baselines = suite_baselines;
       suite.cache = suite_cache;
       const irbench::SuiteResult r = irbench::RunSuite(suite);
-      std::cout << "# suite " << r.name << (suite.bless ? " (blessed)" : "") << "\n" << r.Table();
+      std::cout << "# suite " << r.name << (suite.bless ? " (blessed)" : "") << "\n" << r.Table() << "\nreports:\n";
+      for (const auto& [scenario, report] : r.reports) std::cout << "  " << scenario << "  " << report.string() << "\n";
       if (!r.pass) {
         int failed = 0;
         for (const auto& row : r.rows) failed += !row.pass;

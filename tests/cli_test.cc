@@ -437,6 +437,11 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
   EXPECT_NE(ok.out.find("| p1_flap_both | silhouette_iou_median |"), std::string::npos) << ok.out;
   EXPECT_EQ(ok.out.find("FAIL"), std::string::npos) << ok.out;
+  // Every scenario's report.html, listed after the table.
+  const size_t listed = ok.out.find("  p1_flap_both  ");
+  ASSERT_NE(listed, std::string::npos) << ok.out;
+  const size_t from = listed + std::string("  p1_flap_both  ").size();
+  EXPECT_TRUE(fs::exists(ok.out.substr(from, ok.out.find('\n', from) - from))) << ok.out;
 
   auto degraded = nlohmann::json::parse(ReadText(smoke));
   for (auto& scenario : degraded["scenarios"]) {

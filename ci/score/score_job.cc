@@ -21,7 +21,7 @@ std::string Csv(int total, double v) {
 
 }  // namespace
 
-fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary) {
+fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score* score_out) {
   const fs::path truth = options.sequence / "truth" / "frames.jsonl";
   if (!fs::is_directory(options.sequence)) throw InputError(options.sequence.string(), "", "no such sequence folder");
   if (!fs::is_regular_file(truth)) throw InputError(truth.string(), "", "missing: the sequence has no truth");
@@ -71,6 +71,7 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary) {
   }
   staging.Commit();
   if (summary) *summary = md;
+  if (score_out) *score_out = score;
   return staging.final_path();
 }
 

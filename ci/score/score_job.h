@@ -21,7 +21,10 @@ struct ScoreJobOptions {
 
 // `irbench score`: writes score.json, tables.md, joints.csv (per-joint
 // summary), errors.csv (per frame and joint/hand) and, unless told not to,
-// report.html with plots/ into `out` (complete or not at all). Returns the folder; `summary` (if given) receives the Markdown.
-std::filesystem::path RunScoreJob(const ScoreJobOptions& options, std::string* summary = nullptr);
+// report.html with plots/ into `out` (complete or not at all). Returns the
+// folder; `summary` (if given) receives the Markdown and `score` (if given)
+// the figures.
+std::filesystem::path RunScoreJob(const ScoreJobOptions& options, std::string* summary = nullptr,
+                                  Score* score = nullptr);
 
 }  // namespace irbench

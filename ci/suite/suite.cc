@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "ci/score/score.h"
+#include "ci/score/score_job.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/json_reader.h"
@@ -161,7 +162,7 @@ double MedianSilhouetteIoU(const fs::path& seq, const fs::path& track) {
 
 // What one scenario measured, in the order of its thresholds.
 std::map<std::string, double> RunScenario(const Scenario& sc, const std::string& suite, const fs::path& cache,
-                                          std::mutex* render_mutex) {
+                                          std::mutex* render_mutex, fs::path* report) {
   const auto start = std::chrono::steady_clock::now();
   // Render, or reuse the cached frames of the same inputs. One render at a
   // time: each render job owns the process's GL display while it runs.
@@ -188,7 +189,13 @@ std::map<std::string, double> RunScenario(const Scenario& sc, const std::string&
   track.particles = sc.particles;
   track.overwrite = true;
   RunTrackJob(track);
-  const Score score = ScoreTrack(seq / "truth" / "frames.jsonl", track.out / "track.jsonl");
+  ScoreJobOptions job;
+  job.sequence = seq;
+  job.track = track.out / "track.jsonl";
+  job.out = seq / ("score-" + track.out.filename().string());
+  job.overwrite = true;
+  Score score;
+  *report = RunScoreJob(job, nullptr, &score) / "report.html";
   std::map<std::string, double> metrics;
   metrics["silhouette_iou_median"] = MedianSilhouetteIoU(seq, track.out);
   metrics["tracked_fraction"] = score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
@@ -250,13 +257,14 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   Log().info("suite {}: {} scenario(s), {} at a time", result.name, scenarios.size(), workers);
   std::vector<std::map<std::string, double>> measured(scenarios.size());
   std::vector<std::exception_ptr> errors(scenarios.size());
+  std::vector<fs::path> reports(scenarios.size());
   std::atomic<size_t> next{0};
   std::mutex render_mutex;
   const auto work = [&] {
     for (size_t i; (i = next++) < scenarios.size();) {
       try {
         Log().info("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), scenarios[i].name);
-        measured[i] = RunScenario(scenarios[i], result.name, cache, &render_mutex);
+        measured[i] = RunScenario(scenarios[i], result.name, cache, &render_mutex, &reports[i]);
       } catch (...) {
         errors[i] = std::current_exception();
         next = scenarios.size();  // start no more
@@ -275,6 +283,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   for (size_t i = 0; i < scenarios.size(); ++i) {
     const Scenario& sc = scenarios[i];
     const std::map<std::string, double>& metrics = measured[i];
+    result.reports.emplace_back(sc.name, reports[i]);
     for (const auto& [metric, bound] : sc.thresholds) {
       MetricResult r;
       r.scenario = sc.name;

@@ -6,7 +6,8 @@
 // render inputs and the tool version, under renders/cache/), tracked and
 // scored; its metrics are checked against the thresholds and against the
 // blessed baseline (ci/baselines/<name>.json) within the metric's tolerance.
-// `--bless` writes the baseline from this run on purpose.
+// `--bless` writes the baseline from this run on purpose. Each scenario's
+// score, tables and report.html are written beside its track in the cache.
 //
 // Scenarios run in parallel, up to `jobs` at a time (default: the core
 // count): renders one at a time (a render job owns the process's GL display),
@@ -51,6 +52,7 @@ struct MetricResult {
 struct SuiteResult {
   std::string name;
   std::vector<MetricResult> rows;
+  std::vector<std::pair<std::string, std::filesystem::path>> reports;  // scenario -> its report.html
   bool pass = true;
   std::string Table() const;  // Markdown
 };

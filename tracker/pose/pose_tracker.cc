@@ -384,7 +384,7 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
   // centre until the walk itself is seen.
   if (walking_ || entering_) {
     const double heading = YawFacing(walking_ ? velocity_xy_.normalized() : walk_dir_);
-    if (std::cos(next.dof[kDofYaw] - heading) < 0) next.dof[kDofYaw] = heading + 0.1 * n01(rng_);
+    if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
   return next;
