@@ -7,6 +7,6 @@ cd "$(dirname "$0")/.."
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 ctest --test-dir build --output-on-failure -j"$(nproc)"
-# The README's first command with a short setting: 30 frames rendered, tracked,
+# The README's first command with a short setting: 60 frames rendered, tracked,
 # scored, the tables printed and report.html written.
-./ci/demo.sh --frames 30 --out build/ci-demo
+./ci/demo.sh --frames 60 --out build/ci-demo
