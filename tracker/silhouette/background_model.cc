@@ -6,6 +6,10 @@
 #include <stdexcept>
 
 namespace irbench {
+namespace {
+// Fewer pixels than this that follow the light clearly: L cannot be read.
+constexpr int kMinLightPixels = 50;
+}  // namespace
 
 void BackgroundOptions::Check() const {
   if (model != "flicker" && model != "plain") {
@@ -56,46 +60,58 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   const cv::Mat mean = sum / n;
   // With (almost) no light change in training, b is not identifiable: plain.
   const bool flicker = options.model == "flicker";
-  const bool regress = flicker && light_var > 0.05 && n >= 3;
-  cv::Mat b = regress ? cv::Mat(sum_l / (n * light_var))
-              : flicker && light_mean > 1 ? cv::Mat(mean / light_mean)
-                                          : cv::Mat::zeros(size, CV_64F);
-  cv::Mat a = mean - b * light_mean;
-  cv::Mat sq = cv::Mat::zeros(size, CV_64F);
-  for (int i = 0; i < n; ++i) {
-    cv::Mat f;
-    frames[i].convertTo(f, CV_64F);
-    cv::Mat r = f - (a + b * light[i]);
-    sq += r.mul(r);
-  }
-  const int dof = std::max(1, n - (regress ? 2 : 1));
-  cv::Mat sigma;
-  cv::sqrt(sq / dof, sigma);
+  bool regress = flicker && light_var > 0.05 && n >= 3;
+  // Fits a, b and sigma per pixel and picks the pixels the light is read from
+  // (those that follow it clearly: b well above its noise). A regression whose
+  // slopes too few pixels show significantly (a light change in training too
+  // small for the noise) falls back to pixels scaling with the light: the
+  // whole stage still brightens with a flash, and L must follow it.
+  const auto fit = [&](bool by_regression) {
+    cv::Mat b = by_regression ? cv::Mat(sum_l / (n * light_var))
+                : flicker && light_mean > 1 ? cv::Mat(mean / light_mean)
+                                            : cv::Mat::zeros(size, CV_64F);
+    cv::Mat a = mean - b * light_mean;
+    cv::Mat sq = cv::Mat::zeros(size, CV_64F);
+    for (int i = 0; i < n; ++i) {
+      cv::Mat f;
+      frames[i].convertTo(f, CV_64F);
+      cv::Mat r = f - (a + b * light[i]);
+      sq += r.mul(r);
+    }
+    const int dof = std::max(1, n - (by_regression ? 2 : 1));
+    cv::Mat sigma;
+    cv::sqrt(sq / dof, sigma);
+    a.convertTo(m.a_, CV_32F);
+    b.convertTo(m.b_, CV_32F);
+    sigma = cv::max(sigma, options.min_sigma);
+    sigma.convertTo(m.sigma_, CV_32F);
+    m.light_pixels_ = cv::Mat::zeros(size, CV_8U);
+    if (flicker && !by_regression) m.light_pixels_ = m.b_ > 0.2;
+    if (by_regression) {
+      for (int y = 0; y < size.height; ++y) {
+        const float* bp = m.b_.ptr<float>(y);
+        const float* sp = m.sigma_.ptr<float>(y);
+        uint8_t* lp = m.light_pixels_.ptr<uint8_t>(y);
+        for (int x = 0; x < size.width; ++x) {
+          // b's standard error is σ / (sqrt(n) · std(L)).
+          lp[x] = bp[x] > 0.2 && bp[x] > 3 * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
+        }
+      }
+    }
+    if (!m.screen_.empty()) m.light_pixels_.setTo(0, m.screen_);
+    return dof;
+  };
   mean.convertTo(m.mean_, CV_32F);
   if (options.model == "flicker" && !screen.empty() && cv::countNonZero(screen) >= 50) {
     m.screen_ = screen.clone();
     // Screen pixels follow the projection, not L: they take no part in
     // estimating L and are modelled by their own gain.
   }
-  a.convertTo(m.a_, CV_32F);
-  b.convertTo(m.b_, CV_32F);
-  sigma = cv::max(sigma, options.min_sigma);
-  sigma.convertTo(m.sigma_, CV_32F);
-  // Light is read from pixels that follow it clearly: b well above its noise.
-  m.light_pixels_ = cv::Mat::zeros(size, CV_8U);
-  if (flicker && !regress) m.light_pixels_ = m.b_ > 0.2;
-  if (regress) {
-    for (int y = 0; y < size.height; ++y) {
-      const float* bp = m.b_.ptr<float>(y);
-      const float* sp = m.sigma_.ptr<float>(y);
-      uint8_t* lp = m.light_pixels_.ptr<uint8_t>(y);
-      for (int x = 0; x < size.width; ++x) {
-        // b's standard error is σ / (sqrt(n) · std(L)).
-        lp[x] = bp[x] > 0.2 && bp[x] > 3 * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
-      }
-    }
+  int dof = fit(regress);
+  if (regress && cv::countNonZero(m.light_pixels_) < kMinLightPixels) {
+    regress = false;
+    dof = fit(false);
   }
-  if (!m.screen_.empty()) m.light_pixels_.setTo(0, m.screen_);
   // The pooled difference's noise, measured where it is used.
   if (flicker && options.pool_sigma > 0) {
     double sum_sq = 0;
@@ -155,7 +171,7 @@ cv::Mat BackgroundModel::Expected(double light) const {
 }
 
 double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
-  if (cv::countNonZero(light_pixels_) < 50) return mean_light_;
+  if (cv::countNonZero(light_pixels_) < kMinLightPixels) return mean_light_;
   std::vector<float> estimates;
   estimates.reserve(static_cast<size_t>(cv::countNonZero(light_pixels_)));
   // Every other row and column: a quarter of the pixels is plenty for a median.

@@ -74,6 +74,8 @@ class BackgroundModel {
   const cv::Mat& a() const { return a_; }
   const cv::Mat& b() const { return b_; }
   const cv::Mat& sigma() const { return sigma_; }
+  // Pixels L(t) is read from (0 for the plain model: L is the training mean).
+  int light_pixel_count() const { return light_pixels_.empty() ? 0 : cv::countNonZero(light_pixels_); }
   double mean_light() const { return mean_light_; }
   // The expected empty-stage image at light level `light`.
   cv::Mat Expected(double light) const;
