@@ -160,7 +160,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
                            "#e6ab02", "#a6761d", "#666666", "#1f78b4"};
   auto series_plot = [&](const std::map<std::string, std::vector<std::tuple<int, double, bool>>>& series,
                          const std::vector<std::string>& names, const std::string& prefix,
-                         const std::string& ylabel) {
+                         const std::string& title_suffix, const std::string& ylabel) {
     gp << "set ylabel " << Quoted(ylabel) << "\n";
     std::vector<std::string> parts;
     for (size_t i = 0; i < names.size(); ++i) {
@@ -169,7 +169,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
       const std::string file = prefix + names[i] + ".dat";
       WriteSeries(workdir / file, it->second);
       parts.push_back(Quoted(file) + " using 1:2 with lines lw 1.5 lc rgb \"" + colours[i % 9] + "\" title " +
-                      Quoted(TitleCase(prefix == "time_pointing_" ? names[i] + " hand" : names[i])));
+                      Quoted(TitleCase(names[i]) + title_suffix));
     }
     if (parts.empty()) {
       gp << "set label 1 \"not scored\" at graph 0.5, graph 0.5 center\nplot [0:1] [0:1] 2 notitle\nunset label 1\n";
@@ -179,9 +179,9 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
     for (size_t i = 0; i < parts.size(); ++i) gp << (i ? ", \\\n     " : "") << parts[i];
     gp << "\n";
   };
-  series_plot(score.joint_errors, joints, "time_", "joint error, cm");
+  series_plot(score.joint_errors, joints, "time_", "", "joint error, cm");
   gp << "set title \"Pointing\"\n";
-  series_plot(score.pointing_errors, {"right", "left"}, "time_pointing_", "pointing error, degrees");
+  series_plot(score.pointing_errors, {"right", "left"}, "time_pointing_", " hand", "pointing error, degrees");
   gp << "unset multiplot\n";
 
   AtomicWriteFile(workdir / "plots.gp", gp.str());

@@ -23,23 +23,6 @@ namespace {
 
 using Json = nlohmann::json;
 
-std::map<int, Json> ReadLines(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "", "cannot read (no such file?)");
-  std::map<int, Json> out;
-  std::string text;
-  for (int line = 1; std::getline(in, text); ++line) {
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    Json j = Json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("frame") || !j["frame"].is_number_integer()) {
-      throw InputError(path.string(), "line " + std::to_string(line), "not a JSON object with an integer frame");
-    }
-    const int frame = j["frame"].get<int>();
-    out[frame] = std::move(j);
-  }
-  return out;
-}
-
 std::string Escape(const std::string& s) {
   std::string out;
   for (char c : s) {
@@ -186,8 +169,10 @@ std::optional<PosedBody> TrackedModel(const Json& line) {
 // The viewer's data: cameras, joint names, bones, and per frame the truth's
 // 2D joints, the tracked joints projected and the tracked model's outlines.
 Json ViewerData(const Score& score, const ReportOptions& options, const SequenceInput& input) {
-  const std::map<int, Json> truth = ReadLines(options.sequence / "truth" / "frames.jsonl");
-  const std::map<int, Json> track = fs::is_regular_file(options.track) ? ReadLines(options.track) : std::map<int, Json>{};
+  // Read again for what the score does not keep: the truth's 2D joints, the
+  // track's 3D joints and model.
+  const std::map<int, Json> truth = ReadFrameLines(options.sequence / "truth" / "frames.jsonl");
+  const std::map<int, Json> track = fs::is_regular_file(options.track) ? ReadFrameLines(options.track) : std::map<int, Json>{};
   const std::vector<Camera>& cameras = input.cameras();
 
   Json data;
@@ -246,7 +231,19 @@ Json ViewerData(const Score& score, const ReportOptions& options, const Sequence
     fr["s"] = state;
     fr["present"] = t != truth.end() && t->second.value("present", false);
     std::optional<PosedBody> model;
-    if (k != track.end() && state == "tracking") model = TrackedModel(k->second);
+    // The tracked joints (world), in `names` order.
+    std::vector<std::optional<Eigen::Vector3d>> tracked(names.size());
+    if (k != track.end() && state == "tracking") {
+      model = TrackedModel(k->second);
+      const Json& j3d = k->second.contains("joints3d") ? k->second["joints3d"] : Json();
+      for (size_t n = 0; n < names.size() && j3d.is_object(); ++n) {
+        const auto p = j3d.find(names[n]);
+        if (p != j3d.end() && p->is_array() && p->size() == 3 && (*p)[0].is_number() && (*p)[1].is_number() &&
+            (*p)[2].is_number()) {
+          tracked[n] = Eigen::Vector3d((*p)[0].get<double>(), (*p)[1].get<double>(), (*p)[2].get<double>());
+        }
+      }
+    }
     Json per_truth = Json::array(), per_track = Json::array(), per_model = Json::array();
     for (const Camera& cam : cameras) {
       // Truth: x, y, visibility per joint (null when absent).
@@ -270,22 +267,14 @@ Json ViewerData(const Score& score, const ReportOptions& options, const Sequence
       // Tracked joints, projected with the calibration.
       Json kj = Json::array();
       bool any = false;
-      for (const std::string& n : names) {
-        const Json* p = nullptr;
-        if (k != track.end() && state == "tracking" && k->second.contains("joints3d") &&
-            k->second["joints3d"].is_object() && k->second["joints3d"].contains(n)) {
-          p = &k->second["joints3d"][n];
+      for (const std::optional<Eigen::Vector3d>& w : tracked) {
+        if (w && (cam.cam_from_world * *w).z() > 0.05) {
+          const Eigen::Vector2d px = cam.Project(*w);
+          kj.push_back(Round1(px.x())), kj.push_back(Round1(px.y()));
+          any = true;
+        } else {
+          kj.push_back(nullptr), kj.push_back(nullptr);
         }
-        if (p && p->is_array() && p->size() == 3 && (*p)[0].is_number()) {
-          const Eigen::Vector3d w((*p)[0].get<double>(), (*p)[1].get<double>(), (*p)[2].get<double>());
-          if ((cam.cam_from_world * w).z() > 0.05) {
-            const Eigen::Vector2d px = cam.Project(w);
-            kj.push_back(Round1(px.x())), kj.push_back(Round1(px.y()));
-            any = true;
-            continue;
-          }
-        }
-        kj.push_back(nullptr), kj.push_back(nullptr);
       }
       per_track.push_back(any ? kj : Json(nullptr));
       Json outlines = Json::array();

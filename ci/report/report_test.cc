@@ -21,6 +21,7 @@
 #include "ci/report/plots.h"
 #include "ci/score/score_job.h"
 #include "sim/sequence/render_job.h"
+#include "tests/render_session.h"
 #include "tests/test_util.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/model/body_model.h"
@@ -36,18 +37,8 @@ class ReportTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = irbench::testing::FreshTempDir("report_" + std::to_string(::getpid()));
-    irbench::testing::WriteText(dir_ / "s.json", R"({"format": "irbench.session/1", "crossfade_s": 0.2, "items": [
-      {"motion": "point", "target": "helicopter", "side": "right", "hold_s": 0.4}]})");
-    RenderJobOptions options;
-    options.rig = "lab4";
-    options.scene = "theater";
-    options.motion = (dir_ / "s.json").string();
-    options.background_frames = 0;
-    options.supersample = 1;
-    options.out = dir_ / "seq";
-    RunRenderJob(options);
-    std::ifstream in(dir_ / "seq/truth/frames.jsonl");
-    for (std::string line; std::getline(in, line);) truth_.push_back(Json::parse(line));
+    truth_ = irbench::testing::RenderSession(dir_, R"([
+      {"motion": "point", "target": "helicopter", "side": "right", "hold_s": 0.4}])");
     // The track: the truth, the right elbow 3 cm off, and the irbench model
     // (standing, 1.75 m) where the truth has the person.
     std::ofstream track(dir_ / "track.jsonl");
@@ -115,7 +106,9 @@ TEST_F(ReportTest, TablesPlotsAndViewerDataSayWhatTheTruthSays) {
   int counted = 0;
   for (double centre, n; bins >> centre >> n;) {
     counted += int(n);
-    if (n > 0) EXPECT_LT(std::abs(centre - 3.0), 0.2) << centre;
+    if (n > 0) {
+      EXPECT_LT(std::abs(centre - 3.0), 0.2) << centre;
+    }
   }
   EXPECT_EQ(counted, elbow.total - elbow.outliers);
 

@@ -95,6 +95,12 @@ std::string Fixed(double v, int digits) {
 
 }  // namespace
 
+std::map<int, Json> ReadFrameLines(const fs::path& path) {
+  std::map<int, Json> by_frame;
+  ReadJsonLines(path, &by_frame);
+  return by_frame;
+}
+
 std::string TitleCase(const std::string& joint) {
   std::string out;
   bool up = true;

@@ -14,6 +14,7 @@
 
 #include "common/error.h"
 #include "sim/sequence/render_job.h"
+#include "tests/render_session.h"
 #include "tests/test_util.h"
 
 namespace irbench {
@@ -49,19 +50,9 @@ class ScoreTest : public ::testing::Test {
   static void SetUpTestSuite() {
     // ctest runs each test in its own process, maybe at once: a folder per process.
     dir_ = irbench::testing::FreshTempDir("score_" + std::to_string(::getpid()));
-    irbench::testing::WriteText(dir_ / "s.json", R"({"format": "irbench.session/1", "crossfade_s": 0.2, "items": [
+    truth_ = irbench::testing::RenderSession(dir_, R"([
       {"motion": "point", "target": "helicopter", "side": "right", "hold_s": 0.8},
-      {"motion": "raise_overhead", "side": "left", "hold_s": 0.3}]})");
-    RenderJobOptions options;
-    options.rig = "lab4";
-    options.scene = "theater";
-    options.motion = (dir_ / "s.json").string();
-    options.background_frames = 0;
-    options.supersample = 1;
-    options.out = dir_ / "seq";
-    RunRenderJob(options);
-    std::ifstream in(dir_ / "seq/truth/frames.jsonl");
-    for (std::string line; std::getline(in, line);) truth_.push_back(Json::parse(line));
+      {"motion": "raise_overhead", "side": "left", "hold_s": 0.3}])");
   }
   // A track line that says exactly what the truth says.
   static Json Perfect(const Json& t) {

@@ -119,16 +119,22 @@ std::vector<Vector3d> EllipsoidRim(const Ellipsoid& ellipsoid, const Vector3d& c
   return out;
 }
 
+std::vector<ImageEllipse> ProjectBody(const Camera& camera, const Eigen::Matrix<double, 3, 4>& P,
+                                      const PosedBody& body) {
+  std::vector<ImageEllipse> out;
+  const Vector3d center = camera.CenterInWorld();
+  for (const Ellipsoid& e : body.segments) {
+    if (auto ellipse = ProjectEllipsoid(P, center, e)) out.push_back(*ellipse);
+  }
+  return out;
+}
+
 std::vector<std::vector<Eigen::Vector2d>> BodyOutlines(const Camera& camera, const PosedBody& body, int count) {
-  const Eigen::Matrix<double, 3, 4> P = ProjectionMatrix(camera);
   const Eigen::Matrix3d K_inv = camera.K().inverse();
-  const Eigen::Vector3d center = camera.CenterInWorld();
   std::vector<std::vector<Eigen::Vector2d>> out;
-  for (const Ellipsoid& segment : body.segments) {
-    const std::optional<ImageEllipse> e = ProjectEllipsoid(P, center, segment);
-    if (!e) continue;
+  for (const ImageEllipse& e : ProjectBody(camera, ProjectionMatrix(camera), body)) {
     std::vector<Eigen::Vector2d> ideal;
-    e->Contour(count, &ideal, nullptr);
+    e.Contour(count, &ideal, nullptr);
     std::vector<Eigen::Vector2d>& outline = out.emplace_back();
     for (const Eigen::Vector2d& p : ideal) {
       const Eigen::Vector3d n = K_inv * p.homogeneous();

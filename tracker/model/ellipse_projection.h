@@ -56,6 +56,11 @@ std::optional<ImageEllipse> ProjectEllipsoid(const Eigen::Matrix<double, 3, 4>& 
 std::vector<Eigen::Vector3d> EllipsoidRim(const Ellipsoid& ellipsoid, const Eigen::Vector3d& camera_center_world,
                                           int count);
 
+// The model's segments projected into one camera with its P (ideal pixels);
+// segments that do not project to an ellipse are left out.
+std::vector<ImageEllipse> ProjectBody(const Camera& camera, const Eigen::Matrix<double, 3, 4>& P,
+                                      const PosedBody& body);
+
 // The posed body's segment outlines as the camera's real (distorted) image
 // shows them: each segment's analytic outline, `count` points, taken from
 // ideal pixels through the camera's lens distortion. What overlays and the

@@ -106,16 +106,6 @@ double SilhouetteView::OverlapRatio(const std::vector<ImageEllipse>& ellipses) c
   return union_area > 0 ? static_cast<double>(overlap) / union_area : 0.0;
 }
 
-std::vector<ImageEllipse> ProjectBody(const Camera& camera, const Eigen::Matrix<double, 3, 4>& P,
-                                      const PosedBody& body) {
-  std::vector<ImageEllipse> out;
-  const Eigen::Vector3d center = camera.CenterInWorld();
-  for (const Ellipsoid& e : body.segments) {
-    if (auto ellipse = ProjectEllipsoid(P, center, e)) out.push_back(*ellipse);
-  }
-  return out;
-}
-
 std::vector<std::vector<Eigen::Vector2d>> OutlinePolygons(const cv::Mat& silhouette, double tolerance_px,
                                                           double min_area_px) {
   std::vector<std::vector<cv::Point>> contours;

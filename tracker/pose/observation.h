@@ -56,11 +56,6 @@ class SilhouetteView {
 // with the same K.
 void MakeUndistortMaps(const Camera& camera, cv::Mat* map1, cv::Mat* map2);
 
-// The model's segments projected into one camera (ideal pixels); segments
-// that do not project to an ellipse are left out.
-std::vector<ImageEllipse> ProjectBody(const Camera& camera, const Eigen::Matrix<double, 3, 4>& P,
-                                      const PosedBody& body);
-
 // The outer outlines of a silhouette as closed polygons (thesis 6.2.4 fits to
 // polygons rather than every contour pixel): contours of at least
 // `min_area_px`, simplified to within `tolerance_px`.

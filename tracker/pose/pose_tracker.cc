@@ -6,6 +6,7 @@
 #include <limits>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -575,14 +576,17 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     // against the torso is poorly determined, and the best particle alone
     // flickers between nearby poses.
     std::vector<double> vote_weight(n);
-    for (int i = 0; i < n; ++i) vote_weight[i] = std::exp((log_likelihood[i] - log_likelihood[best]) / 10.0);
+    std::vector<std::optional<PosedBody>> voters(n);  // posed once, for both arms
+    for (int i = 0; i < n; ++i) {
+      vote_weight[i] = std::exp((log_likelihood[i] - log_likelihood[best]) / 10.0);
+      if (vote_weight[i] >= 1e-3) voters[i] = PoseBody(shape_, proposed[i]);
+    }
     for (int side = 0; side < 2; ++side) {
       const bool left = side == 1;
       double rest_weight = 0, total_weight = 0;
       for (int i = 0; i < n; ++i) {
-        if (vote_weight[i] < 1e-3) continue;
-        const PosedBody b = PoseBody(shape_, proposed[i]);
-        const auto& j = b.joints;
+        if (!voters[i]) continue;
+        const auto& j = voters[i]->joints;
         const bool r = rest_->AtRest(RestFeatures(
             j[kModelWaist], j[kModelNeck], j[kModelRightShoulder], j[kModelLeftShoulder],
             j[left ? kModelLeftElbow : kModelRightElbow], j[left ? kModelLeftWrist : kModelRightWrist],
