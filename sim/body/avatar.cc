@@ -1,4 +1,5 @@
 #include "sim/body/avatar.h"
+#include "sim/scene/materials.h"
 
 #include <cctype>
 #include <cmath>
@@ -17,7 +18,7 @@ struct Ring {
   double ra, rb;                   // semi-axes, metres
   int bone0, bone1;
   float weight0;  // weight of bone0; bone1 gets the rest
-  float albedo;
+  NirReflectance albedo;
 };
 
 class MeshBuilder {
@@ -90,7 +91,7 @@ class MeshBuilder {
   uint32_t AddVertex(const Eigen::Vector3d& p, const Ring& r) {
     MeshVertex v;
     v.position = p.cast<float>();
-    v.albedo = r.albedo;
+    v.SetReflectance(r.albedo);
     avatar_.bind_vertices.push_back(v);
     avatar_.bone_index.push_back({static_cast<uint8_t>(r.bone0), static_cast<uint8_t>(r.bone1), 0, 0});
     avatar_.bone_weight.push_back({r.weight0, 1.0f - r.weight0, 0, 0});
@@ -137,7 +138,7 @@ std::vector<Ring> LimbRings(const Eigen::Vector3d& p0,
                             int parent_bone,
                             int bone,
                             int child_bone,
-                            float albedo,
+                            NirReflectance albedo,
                             int n = 10) {
   std::vector<Ring> rings;
   const Eigen::Vector3d dir = (p1 - p0).normalized();
@@ -396,11 +397,8 @@ Avatar LoadAvatar(const std::filesystem::path& path) {
   if (root.Has("albedo")) {
     const JsonNode a = root["albedo"];
     a.CheckKeys({"skin", "shirt", "pants", "shoes", "hair"});
-    auto read = [&](const char* key, float& out) {
-      if (!a.Has(key)) return;
-      const double v = a.GetDouble(key);
-      if (v < 0 || v > 1) a[key].Fail("must be in [0, 1]");
-      out = static_cast<float>(v);
+    auto read = [&](const char* key, NirReflectance& out) {
+      if (a.Has(key)) out = ReadReflectance(a[key]);
     };
     read("skin", params.skin_albedo);
     read("shirt", params.shirt_albedo);

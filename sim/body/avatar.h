@@ -22,11 +22,12 @@ struct AvatarParams {
   std::string kind = "tube";  // tube, parametric, mesh (imported)
   double height_m = 1.75;
   double build = 1.0;  // girth factor: 0.8 slim .. 1.4 heavy
-  float skin_albedo = 0.55f;
-  float shirt_albedo = 0.45f;
-  float pants_albedo = 0.35f;
-  float shoe_albedo = 0.15f;
-  float hair_albedo = 0.25f;
+  // Near-IR reflectance of each part at 850 and 940 nm (sim/scene/materials.h).
+  NirReflectance skin_albedo = NirReflectance::Grey(0.55f);
+  NirReflectance shirt_albedo = NirReflectance::Grey(0.45f);
+  NirReflectance pants_albedo = NirReflectance::Grey(0.35f);
+  NirReflectance shoe_albedo = NirReflectance::Grey(0.15f);
+  NirReflectance hair_albedo = NirReflectance::Grey(0.25f);
   // How this person moves: fields of MotionStyle (docs/motion.md) that
   // override the seeded draw; checked by the motion library.
   nlohmann::json style = nullptr;

@@ -418,7 +418,7 @@ class BodyBuilder {
       int owner = 0;
       Sdf(p, &owner);
       owner_[v] = owner;
-      mv.albedo = Albedo(primitives_[owner].region, p);
+      mv.SetReflectance(Albedo(primitives_[owner].region, p));
       mv.emissive = 0.0f;
     }
   }
@@ -531,7 +531,7 @@ class BodyBuilder {
     F = std::move(indices);
   }
 
-  float Albedo(Region region, const Vec3& p) const {
+  NirReflectance Albedo(Region region, const Vec3& p) const {
     switch (region) {
       case Region::kShirt: return p_.shirt_albedo;
       case Region::kPants: return p_.pants_albedo;

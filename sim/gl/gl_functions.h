@@ -63,6 +63,7 @@ namespace irbench {
   X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                       \
   X(PFNGLUNIFORM1FPROC, Uniform1f)                                     \
   X(PFNGLUNIFORM1IPROC, Uniform1i)                                     \
+  X(PFNGLUNIFORM1IVPROC, Uniform1iv)                                   \
   X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                   \
   X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                   \
   X(PFNGLDRAWELEMENTSPROC, DrawElements)                               \

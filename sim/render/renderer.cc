@@ -11,12 +11,14 @@ namespace {
 constexpr const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_material;  // albedo, emissive
+layout(location = 2) in vec2 a_material;  // albedo (850 nm), emissive
+layout(location = 3) in vec2 a_extra;     // albedo at 940 nm (< 0: as 850), content emission
 uniform mat4 u_clip_from_world;
 uniform mat4 u_cam_from_world;
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_material;
+out vec2 v_extra;
 out float v_depth;
 void main() {
   vec4 p = vec4(a_position, 1.0);
@@ -24,6 +26,7 @@ void main() {
   v_world = a_position;
   v_normal = a_normal;
   v_material = a_material;
+  v_extra = a_extra;
   v_depth = (u_cam_from_world * p).z;
 }
 )";
@@ -32,6 +35,7 @@ constexpr const char* kFragmentShader = R"(
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_material;
+in vec2 v_extra;
 in float v_depth;
 uniform float u_person;
 uniform vec3 u_camera_center;
@@ -41,13 +45,21 @@ uniform vec3 u_light_position[8];
 uniform vec3 u_light_direction[8];
 uniform float u_light_cos_half[8];
 uniform float u_light_power[8];
+uniform int u_light_band[8];  // 0: 850 nm, 1: 940 nm
+// Bounce light (sim/lighting/bounce.h): irradiance onto +x, -x, +y, -y, +z, -z
+// facing surfaces, channels 850 nm / 940 nm / screen content.
+uniform sampler3D u_bounce[6];
+uniform int u_bounce_on;
+uniform vec3 u_bounce_origin;
+uniform float u_bounce_spacing;
+uniform vec3 u_bounce_dims;
 uniform int u_light_shadow_slot[8];  // -1: no shadow map
 uniform sampler2DArray u_shadow_maps;  // one layer per shadow slot
 uniform mat4 u_shadow_clip_from_world[4];
 uniform mat4 u_shadow_cam_from_world[4];
 uniform float u_shadow_size_uv[4];  // light side / (2 tan(fov / 2))
 uniform float u_shadow_texel[4];    // one texel in uv
-layout(location = 0) out float o_grey;
+layout(location = 0) out vec4 o_radiance;  // 850 nm, 940 nm, content, emission
 layout(location = 1) out float o_mask;
 layout(location = 2) out float o_depth;
 
@@ -101,14 +113,25 @@ float Visibility(int slot, vec3 p) {
 }
 #endif
 
+vec3 Bounce(vec3 p, vec3 n) {
+  vec3 uvw = ((p - u_bounce_origin) / u_bounce_spacing + 0.5) / u_bounce_dims;
+  vec3 n2 = n * n;
+  vec3 ex = n.x >= 0.0 ? texture(u_bounce[0], uvw).rgb : texture(u_bounce[1], uvw).rgb;
+  vec3 ey = n.y >= 0.0 ? texture(u_bounce[2], uvw).rgb : texture(u_bounce[3], uvw).rgb;
+  vec3 ez = n.z >= 0.0 ? texture(u_bounce[4], uvw).rgb : texture(u_bounce[5], uvw).rgb;
+  return n2.x * ex + n2.y * ey + n2.z * ez;
+}
+
 void main() {
   vec3 n = normalize(v_normal);
   if (dot(n, u_camera_center - v_world) < 0.0) n = -n;  // two-sided
-  float radiance;
+  vec4 radiance = vec4(0.0);
   if (v_material.y > 0.5) {
-    radiance = v_material.x;
+    radiance.a = v_material.x;
   } else {
-    float irradiance = u_ambient;
+    // Irradiance per channel: illuminators at 850 and 940 nm, screen content.
+    vec3 irradiance = vec3(u_ambient, 0.0, 0.0);
+    if (u_bounce_on != 0) irradiance += Bounce(v_world, n);
     for (int i = 0; i < u_light_count; ++i) {
       vec3 to_light = u_light_position[i] - v_world;
       float d2 = max(dot(to_light, to_light), 0.25);
@@ -121,11 +144,15 @@ void main() {
 #if SHADOWS
       if (slot >= 0 && cone * lambert > 0.0) vis = Visibility(slot, v_world);
 #endif
-      irradiance += u_light_power[i] * cone * lambert * vis / d2;
+      float e = u_light_power[i] * cone * lambert * vis / d2;
+      if (u_light_band[i] == 0) irradiance.x += e; else irradiance.y += e;
     }
-    radiance = v_material.x * irradiance;
+    float r850 = v_material.x;
+    float r940 = v_extra.x < 0.0 ? r850 : v_extra.x;
+    radiance.rgb = vec3(r850, r940, 0.5 * (r850 + r940)) * irradiance;
+    radiance.b += v_extra.y;
   }
-  o_grey = clamp(radiance, 0.0, 1.0);
+  o_radiance = radiance;
   o_mask = u_person;
   o_depth = v_depth;
 }
@@ -209,6 +236,9 @@ void SetupVertexLayout(const GlFunctions& gl) {
   gl.EnableVertexAttribArray(2);
   gl.VertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
                          reinterpret_cast<void*>(offsetof(MeshVertex, albedo)));
+  gl.EnableVertexAttribArray(3);
+  gl.VertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride,
+                         reinterpret_cast<void*>(offsetof(MeshVertex, albedo_940)));
 }
 
 }  // namespace
@@ -227,7 +257,7 @@ struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
   cv::Mat map_x, map_y;  // output pixel -> render pixel
-  cv::Mat raw_grey, raw_mask, raw_depth, blurred_grey, blurred_mask;
+  cv::Mat raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
   Eigen::Matrix4f clip_from_world;
 };
 
@@ -243,6 +273,7 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
   shadow_program_ = LinkProgram(gl, kShadowVertexShader, kShadowFragmentShader);
   gl.UseProgram(program_);
   SetLighting({}, 1.0);
+  SetBounce(IrradianceVolume{});
 
   const int s = options_.supersample;
   for (const Camera& cam : cameras_) {
@@ -301,7 +332,7 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
       gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
       gl.FramebufferTexture2D(GL_FRAMEBUFFER, slot, GL_TEXTURE_2D, *tex, 0);
     };
-    make_texture(&target->grey_tex, GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT0);
+    make_texture(&target->grey_tex, GL_RGBA32F, GL_RGBA, GL_FLOAT, GL_COLOR_ATTACHMENT0);
     make_texture(&target->mask_tex, GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT1);
     make_texture(&target->depth_tex, GL_R32F, GL_RED, GL_FLOAT, GL_COLOR_ATTACHMENT2);
     gl.GenRenderbuffers(1, &target->depth_rbo);
@@ -314,7 +345,7 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
     if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       throw RuntimeError("framebuffer incomplete for camera " + cam.name);
     }
-    target->raw_grey.create(rc.height, rc.width, CV_8UC1);
+    target->raw_radiance.create(rc.height, rc.width, CV_32FC4);
     target->raw_mask.create(rc.height, rc.width, CV_8UC1);
     target->raw_depth.create(rc.height, rc.width, CV_32FC1);
     targets_.push_back(std::move(target));
@@ -345,6 +376,7 @@ Renderer::~Renderer() {
     gl.DeleteRenderbuffers(1, &t->depth_rbo);
   }
   for (unsigned* b : {&static_vbo_, &static_ibo_, &person_vbo_, &person_ibo_}) gl.DeleteBuffers(1, b);
+  if (bounce_textures_[0] != 0) gl.DeleteTextures(6, bounce_textures_);
   for (auto& m : shadow_maps_) {
     gl.DeleteFramebuffers(1, &m->fbo);
     gl.DeleteRenderbuffers(1, &m->depth_rbo);
@@ -361,6 +393,47 @@ const Camera& Renderer::RenderCamera(int index) const { return targets_.at(index
 void Renderer::SetScene(const Scene& scene) {
   SetStaticMesh(scene.mesh);
   SetLighting(scene.lights, scene.ambient);
+  if (scene.bounce.bounces > 0) {
+    BounceOptions options;
+    options.bounces = scene.bounce.bounces;
+    options.patch_m = scene.bounce.patch_m;
+    options.grid_m = scene.bounce.grid_m;
+    SetBounce(ComputeBounce(scene.mesh, scene.lights, options));
+  } else {
+    SetBounce(IrradianceVolume{});
+  }
+}
+
+void Renderer::SetBounce(const IrradianceVolume& volume) {
+  const GlFunctions& gl = gl_;
+  gl.UseProgram(program_);
+  if (bounce_textures_[0] == 0) gl.GenTextures(6, bounce_textures_);
+  const size_t points = volume.empty() ? 0 : size_t(volume.dims.x()) * volume.dims.y() * volume.dims.z();
+  for (int d = 0; d < 6; ++d) {
+    gl.ActiveTexture(GL_TEXTURE2 + d);
+    gl.BindTexture(GL_TEXTURE_3D, bounce_textures_[d]);
+    const float zero[3] = {0, 0, 0};
+    if (volume.empty()) {
+      gl.TexImage3D(GL_TEXTURE_3D, 0, GL_RGB32F, 1, 1, 1, 0, GL_RGB, GL_FLOAT, zero);
+    } else {
+      gl.TexImage3D(GL_TEXTURE_3D, 0, GL_RGB32F, volume.dims.x(), volume.dims.y(), volume.dims.z(), 0, GL_RGB,
+                    GL_FLOAT, volume.values.data() + d * points);
+    }
+    gl.TexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) {
+      gl.TexParameteri(GL_TEXTURE_3D, wrap, GL_CLAMP_TO_EDGE);
+    }
+    gl.Uniform1i(gl.GetUniformLocation(program_, ("u_bounce[" + std::to_string(d) + "]").c_str()), 2 + d);
+  }
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.Uniform1i(gl.GetUniformLocation(program_, "u_bounce_on"), volume.empty() ? 0 : 1);
+  const Eigen::Vector3f origin = volume.origin.cast<float>();
+  const Eigen::Vector3f dims = volume.empty() ? Eigen::Vector3f(Eigen::Vector3f::Ones()) : Eigen::Vector3f(volume.dims.cast<float>());
+  gl.Uniform3fv(gl.GetUniformLocation(program_, "u_bounce_origin"), 1, origin.data());
+  gl.Uniform1f(gl.GetUniformLocation(program_, "u_bounce_spacing"), static_cast<float>(volume.spacing));
+  gl.Uniform3fv(gl.GetUniformLocation(program_, "u_bounce_dims"), 1, dims.data());
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while uploading the bounce light");
 }
 
 void Renderer::SetStaticMesh(const TriangleMesh& mesh) {
@@ -383,7 +456,7 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   gl.Uniform1f(gl.GetUniformLocation(program_, "u_ambient"), static_cast<float>(ambient));
   gl.Uniform1i(gl.GetUniformLocation(program_, "u_light_count"), n);
   std::vector<float> pos(24, 0), dir(24, 0), cos_half(8, 1), power(8, 0);
-  std::vector<int> slot(8, -1);
+  std::vector<int> slot(8, -1), band(8, 0);
   std::vector<float> size_uv(4, 0), texel(4, 1);
   std::vector<Eigen::Matrix4f> shadow_clip(4, Eigen::Matrix4f::Identity()),
       shadow_cam(4, Eigen::Matrix4f::Identity());
@@ -411,6 +484,7 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
     }
     cos_half[i] = static_cast<float>(std::cos(light.cone_deg * M_PI / 360.0));
     power[i] = static_cast<float>(light.power);
+    band[i] = light.wavelength_nm == 940.0 ? 1 : 0;
     if (!options_.shadows || !light.casts_shadows || shadow_maps_.size() >= 4) continue;
     // A pinhole "camera" at the light covering its cone.
     const double fov = std::min(light.cone_deg + 10.0, 150.0) * M_PI / 180.0;
@@ -452,6 +526,7 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_light_direction"), 8, dir.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_light_cos_half"), 8, cos_half.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_light_power"), 8, power.data());
+  gl.Uniform1iv(gl.GetUniformLocation(program_, "u_light_band"), 8, band.data());
   for (int i = 0; i < 8; ++i) {
     gl.Uniform1i(gl.GetUniformLocation(program_, ("u_light_shadow_slot[" + std::to_string(i) + "]").c_str()),
                  slot[i]);
@@ -582,7 +657,7 @@ void Renderer::Read(int index, CameraImages* out, bool want_depth) {
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_UNSIGNED_BYTE, t.raw_grey.data);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RGBA, GL_FLOAT, t.raw_radiance.data);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
   gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_UNSIGNED_BYTE, t.raw_mask.data);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT2);
@@ -595,8 +670,11 @@ void Renderer::Read(int index, CameraImages* out, bool want_depth) {
   // The grey image is low-passed first (a Gaussian of 0.5 output pixels, about a
   // good lens's blur) so edges fall between supersamples instead of snapping
   // to them; this keeps sub-pixel corner positions unbiased and steady.
-  cv::GaussianBlur(t.raw_grey, t.blurred_grey, cv::Size(0, 0), 0.5 * options_.supersample);
-  cv::remap(t.blurred_grey, out->grey, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(t.raw_radiance, t.blurred_radiance, cv::Size(0, 0), 0.5 * options_.supersample);
+  cv::remap(t.blurred_radiance, out->radiance, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  // The plain grey image: every channel at level 1, 1 = 255.
+  cv::transform(out->radiance, out->grey, cv::Matx14f(255.0f, 255.0f, 255.0f, 255.0f));
+  out->grey.convertTo(out->grey, CV_8U);
   // At supersample 2 a bilinear sample at an output pixel centre is exactly the
   // mean of its 2x2 block (the coverage); otherwise a symmetric Gaussian
   // prefilter makes the 50% level fall on the true edge.

@@ -12,6 +12,7 @@
 
 #include "sim/camera/camera.h"
 #include "sim/gl/gl_context.h"
+#include "sim/lighting/bounce.h"
 #include "sim/scene/mesh.h"
 #include "sim/scene/scene.h"
 
@@ -31,7 +32,13 @@ struct RenderOptions {
 };
 
 struct CameraImages {
-  cv::Mat grey;   // CV_8UC1, plain grey shading
+  // CV_32FC4, relative radiance per source (1 = white under irradiance 1):
+  // [0] the illuminators' light at 850 nm, [1] at 940 nm (each times the
+  // surface's reflectance there), [2] the screens' content light (emitted and
+  // reflected), [3] unlit emission (calibration boards). The sensor model
+  // weighs and flickers them apart (docs/sensor.md).
+  cv::Mat radiance;
+  cv::Mat grey;   // CV_8UC1, the plain grey shading: 255 x the channels' sum
   cv::Mat mask;   // CV_8UC1, 255 where the person is seen, 0 else
   cv::Mat depth;  // CV_32FC1, camera z in metres (0: nothing); empty unless asked
 };
@@ -46,8 +53,12 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Static geometry and lighting (uploaded once).
+  // Static geometry and lighting (uploaded once); computes the scene's bounce
+  // light (sim/lighting/bounce.h) unless it has none.
   void SetScene(const Scene& scene);
+  // The bounce light's irradiance volume; an empty one turns it off (the
+  // default).
+  void SetBounce(const IrradianceVolume& volume);
   void SetStaticMesh(const TriangleMesh& mesh);
   void SetLighting(const std::vector<IrLight>& lights, double ambient);
 
@@ -94,6 +105,7 @@ class Renderer {
   unsigned shadow_program_ = 0;
   std::vector<std::unique_ptr<ShadowMap>> shadow_maps_;
   unsigned shadow_array_ = 0;  // GL_TEXTURE_2D_ARRAY, a layer per shadow map
+  unsigned bounce_textures_[6] = {0, 0, 0, 0, 0, 0};  // GL_TEXTURE_3D, one per axis direction
   bool shadows_dirty_ = true;
   unsigned static_vao_ = 0, static_vbo_ = 0, static_ibo_ = 0;
   int static_index_count_ = 0;

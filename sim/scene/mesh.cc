@@ -24,8 +24,7 @@ void AppendQuad(TriangleMesh& mesh,
       MeshVertex vertex;
       vertex.position = (origin + u * (double(i) / n_u) + v * (double(j) / n_v)).cast<float>();
       vertex.normal = normal;
-      vertex.albedo = material.albedo;
-      vertex.emissive = material.emissive;
+      material.Apply(vertex);
       mesh.vertices.push_back(vertex);
     }
   }
@@ -86,8 +85,7 @@ void AppendSphere(TriangleMesh& mesh,
       MeshVertex vertex;
       vertex.position = (center + radius * n).cast<float>();
       vertex.normal = n.cast<float>();
-      vertex.albedo = material.albedo;
-      vertex.emissive = material.emissive;
+      material.Apply(vertex);
       mesh.vertices.push_back(vertex);
     }
   }

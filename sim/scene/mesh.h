@@ -9,13 +9,31 @@
 
 namespace irbench {
 
+// Near-IR diffuse reflectance at the two illuminator wavelengths.
+struct NirReflectance {
+  float at_850 = 0.5f;
+  float at_940 = 0.5f;
+  static NirReflectance Grey(float r) { return {r, r}; }
+  bool operator==(const NirReflectance&) const = default;
+};
+
 struct MeshVertex {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();  // world, metres
   Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
-  float albedo = 0.5f;    // near-IR reflectance in [0, 1]
+  float albedo = 0.5f;    // near-IR reflectance at 850 nm, in [0, 1]
   float emissive = 0.0f;  // 1: shows `albedo` directly, unlit (calibration boards)
+  float albedo_940 = -1.0f;  // reflectance at 940 nm; negative: the same as `albedo`
+  // Radiance the surface emits with the screens' projected content (relative,
+  // like the renderer's radiance); it follows the content's flicker.
+  float content = 0.0f;
+
+  void SetReflectance(const NirReflectance& r) {
+    albedo = r.at_850;
+    albedo_940 = r.at_940;
+  }
+  NirReflectance Reflectance() const { return {albedo, albedo_940 < 0 ? albedo : albedo_940}; }
 };
-static_assert(sizeof(MeshVertex) == 8 * sizeof(float), "tightly packed for the GPU");
+static_assert(sizeof(MeshVertex) == 10 * sizeof(float), "tightly packed for the GPU");
 
 struct TriangleMesh {
   std::vector<MeshVertex> vertices;
@@ -26,8 +44,18 @@ struct TriangleMesh {
 };
 
 struct Material {
-  float albedo = 0.5f;
-  float emissive = 0.0f;
+  float albedo = 0.5f;        // reflectance at 850 nm
+  float emissive = 0.0f;      // 1: unlit, shows `albedo`
+  float albedo_940 = -1.0f;   // negative: the same as `albedo`
+  float content = 0.0f;       // radiance from projected content (screens)
+
+  static Material Of(const NirReflectance& r) { return {r.at_850, 0.0f, r.at_940, 0.0f}; }
+  void Apply(MeshVertex& v) const {
+    v.albedo = albedo;
+    v.emissive = emissive;
+    v.albedo_940 = albedo_940;
+    v.content = content;
+  }
 };
 
 // A parallelogram `origin + a*u + b*v`, a,b in [0,1], subdivided n_u x n_v;

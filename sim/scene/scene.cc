@@ -4,15 +4,14 @@
 #include <set>
 
 #include "common/json_reader.h"
+#include "sim/scene/materials.h"
 
 namespace irbench {
 namespace {
 
 Material ReadMaterial(const JsonNode& node, const std::string& key, float fallback) {
-  Material m;
-  m.albedo = static_cast<float>(node.GetDouble(key, fallback));
-  if (m.albedo < 0 || m.albedo > 1) node[key].Fail("reflectance must be in [0, 1]");
-  return m;
+  if (!node.Has(key)) return Material::Of(NirReflectance::Grey(fallback));
+  return Material::Of(ReadReflectance(node[key]));
 }
 
 void CheckBox(const JsonNode& node, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
@@ -25,7 +24,7 @@ ScreenSurface ReadScreen(const JsonNode& s) {
   const std::string type = s.GetString("type");
   if (type == "cylinder") {
     s.CheckKeys({"name", "type", "center_xy", "radius", "angle_left_deg", "angle_right_deg", "z",
-                 "albedo", "targets", "description"});
+                 "albedo", "content_radiance", "targets", "description"});
     screen.kind = ScreenSurface::Kind::kCylinder;
     screen.center_xy = s["center_xy"].Vec2();
     screen.radius = s.GetDouble("radius");
@@ -41,8 +40,8 @@ ScreenSurface ReadScreen(const JsonNode& s) {
     screen.z1 = z.y();
     if (screen.z1 <= screen.z0) s["z"].Fail("top must be above bottom");
   } else if (type == "plane") {
-    s.CheckKeys({"name", "type", "origin", "right", "up", "width", "height", "albedo", "targets",
-                 "description"});
+    s.CheckKeys({"name", "type", "origin", "right", "up", "width", "height", "albedo", "content_radiance",
+                 "targets", "description"});
     screen.kind = ScreenSurface::Kind::kPlane;
     screen.origin = s.GetVec3("origin");
     screen.right = s.GetVec3("right");
@@ -60,6 +59,12 @@ ScreenSurface ReadScreen(const JsonNode& s) {
     s["type"].Fail("unknown screen type '" + type + "' (cylinder, plane)");
   }
   screen.material = ReadMaterial(s, "albedo", 0.8f);
+  // The near-IR radiance the projected content adds (projectors leak near IR);
+  // it flickers with the content (docs/sensor.md).
+  screen.material.content = static_cast<float>(s.GetDouble("content_radiance", 0.0));
+  if (screen.material.content < 0 || screen.material.content > 10) {
+    s["content_radiance"].Fail("must be in [0, 10]");
+  }
   if (s.Has("targets")) {
     const JsonNode targets = s["targets"];
     const Eigen::Vector2d size = screen.Size();
@@ -88,7 +93,7 @@ nlohmann::json Scene::ScreensJson() const {
 
 Scene LoadScene(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
-  root.CheckKeys({"format", "name", "description", "stage", "ambient", "objects", "screens", "lights"});
+  root.CheckKeys({"format", "name", "description", "stage", "ambient", "bounce", "objects", "screens", "lights"});
   if (root.GetString("format") != "irbench.scene/1") root["format"].Fail("expected \"irbench.scene/1\"");
   Scene scene;
   scene.source = path;
@@ -102,6 +107,20 @@ Scene LoadScene(const std::filesystem::path& path) {
   }
   scene.ambient = root.GetDouble("ambient", 0.3);
   if (scene.ambient < 0) root["ambient"].Fail("must be non-negative");
+  if (root.Has("bounce")) {
+    const JsonNode b = root["bounce"];
+    if (b.raw().is_boolean()) {
+      if (!b.Bool()) scene.bounce.bounces = 0;
+    } else {
+      b.CheckKeys({"bounces", "patch_m", "grid_m"});
+      scene.bounce.bounces = b.GetInt("bounces", scene.bounce.bounces);
+      if (scene.bounce.bounces < 0 || scene.bounce.bounces > 4) b["bounces"].Fail("must be in 0..4");
+      scene.bounce.patch_m = b.GetDouble("patch_m", scene.bounce.patch_m);
+      if (!(scene.bounce.patch_m >= 0.05 && scene.bounce.patch_m <= 5)) b["patch_m"].Fail("must be in [0.05, 5] m");
+      scene.bounce.grid_m = b.GetDouble("grid_m", scene.bounce.grid_m);
+      if (!(scene.bounce.grid_m >= 0.05 && scene.bounce.grid_m <= 5)) b["grid_m"].Fail("must be in [0.05, 5] m");
+    }
+  }
 
   // Rooms enclose everything; they go last in the mesh so that the renderer's
   // depth test rejects their hidden fragments early instead of shading them.

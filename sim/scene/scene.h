@@ -26,12 +26,22 @@ struct IrLight {
   bool casts_shadows = true;
 };
 
+// How the renderer computes the diffuse bounce light (sim/lighting/bounce.h).
+struct SceneBounce {
+  int bounces = 2;       // 0: none; 1: light reflected once; 2: once more
+  double patch_m = 0.5;  // patch size
+  double grid_m = 0.5;   // irradiance volume spacing
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path source;
   Eigen::Vector2d stage_center = Eigen::Vector2d::Zero();
   Eigen::Vector2d stage_size = Eigen::Vector2d(3, 3);
-  double ambient = 0.3;  // diffuse light reflected from the screens, relative
+  // Unshadowed fill light on every lit surface (stray light the bounce does
+  // not model); it counts as the illuminators' 850 nm light.
+  double ambient = 0.3;
+  SceneBounce bounce;
   std::vector<ScreenSurface> screens;
   std::vector<IrLight> lights;
   TriangleMesh mesh;  // all static geometry, screens included

@@ -92,8 +92,7 @@ void ScreenSurface::AppendGeometry(TriangleMesh& mesh) const {
       MeshVertex v;
       v.position = (Eigen::Vector3d(center_xy.x(), center_xy.y(), z) + radius * radial).cast<float>();
       v.normal = (-radial).cast<float>();  // faces the centre
-      v.albedo = material.albedo;
-      v.emissive = material.emissive;
+      material.Apply(v);
       mesh.vertices.push_back(v);
     }
   }

@@ -42,7 +42,7 @@ double FlickerModel::ScreenLevel(double t) const {
   return previous.level + (current.level - previous.level) * u;
 }
 
-double FlickerModel::Level(double t, double exposure_s) const {
+double FlickerModel::ScreenMean(double t, double exposure_s) const {
   double level = ScreenLevel(t + 0.5 * exposure_s);
   // Flashes: the fraction of the exposure each one overlaps.
   for (double start : flashes_) {
@@ -50,17 +50,22 @@ double FlickerModel::Level(double t, double exposure_s) const {
         std::min(t + exposure_s, start + params_.flash_s) - std::max(t, start);
     if (overlap > 0) level += params_.flash_gain * overlap / std::max(exposure_s, 1e-9);
   }
-  if (params_.mains_depth > 0 && params_.mains_hz > 0) {
-    // Mean of 1 + d sin(w t + phi) over [t, t + e].
-    const double w = 2 * M_PI * params_.mains_hz;
-    const double mean_sin =
-        exposure_s > 0
-            ? (std::cos(w * t + mains_phase_) - std::cos(w * (t + exposure_s) + mains_phase_)) /
-                  (w * exposure_s)
-            : std::sin(w * t + mains_phase_);
-    level *= 1.0 + params_.mains_depth * mean_sin;
-  }
   return level;
+}
+
+double FlickerModel::MainsMean(double t, double exposure_s) const {
+  if (params_.mains_depth <= 0 || params_.mains_hz <= 0) return 1.0;
+  // Mean of 1 + d sin(w t + phi) over [t, t + e].
+  const double w = 2 * M_PI * params_.mains_hz;
+  const double mean_sin =
+      exposure_s > 0
+          ? (std::cos(w * t + mains_phase_) - std::cos(w * (t + exposure_s) + mains_phase_)) / (w * exposure_s)
+          : std::sin(w * t + mains_phase_);
+  return 1.0 + params_.mains_depth * mean_sin;
+}
+
+double FlickerModel::Level(double t, double exposure_s) const {
+  return ScreenMean(t, exposure_s) * MainsMean(t, exposure_s);
 }
 
 }  // namespace irbench

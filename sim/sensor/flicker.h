@@ -15,8 +15,14 @@ class FlickerModel {
   // Precomputes the seeded screen events over [start_s, end_s].
   FlickerModel(const FlickerParams& params, uint64_t seed, double start_s, double end_s);
 
-  // Mean illumination level over the exposure [t, t + exposure_s].
+  // Mean illumination level over the exposure [t, t + exposure_s] of a
+  // surface lit by the screen and the illuminators alike: ScreenMean x MainsMean.
   double Level(double t, double exposure_s) const;
+  // The screens' content light over the exposure: the content level at its
+  // middle plus the flashes' share.
+  double ScreenMean(double t, double exposure_s) const;
+  // The illuminators' mains/PWM modulation averaged over the exposure.
+  double MainsMean(double t, double exposure_s) const;
   // The screen-content part alone at time t.
   double ScreenLevel(double t) const;
 

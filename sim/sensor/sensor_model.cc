@@ -47,6 +47,7 @@ template <class F>
 void VisitKnobs(SensorParams& p, F&& f) {
   f("photons_per_ms", p.photons_per_ms);
   f("quantum_efficiency", p.quantum_efficiency);
+  f("quantum_efficiency_940", p.quantum_efficiency_940);
   f("full_well_e", p.full_well_e);
   f("system_gain_dn_per_e", p.system_gain_dn_per_e);
   f("dark_noise_e", p.dark_noise_e);
@@ -89,6 +90,7 @@ template <class F>
 void VisitKnobs(CaptureParams& p, F&& f) {
   f("drop_rate", p.drop_rate);
   f("sync_jitter_ms", p.sync_jitter_ms);
+  f("rolling_shutter_ms", p.rolling_shutter_ms);
 }
 
 template <class P>
@@ -133,6 +135,7 @@ void CheckOptics(const OpticsParams& o, const std::string& file, const std::stri
 void CheckCapture(const CaptureParams& c, const std::string& file, const std::string& p) {
   CheckRange(c.drop_rate, 0, 0.5, file, p + "drop_rate");
   CheckRange(c.sync_jitter_ms, 0, 100, file, p + "sync_jitter_ms");
+  CheckRange(c.rolling_shutter_ms, 0, 1000, file, p + "rolling_shutter_ms");
 }
 
 }  // namespace
@@ -140,6 +143,7 @@ void CheckCapture(const CaptureParams& c, const std::string& file, const std::st
 void SensorParams::Check(const std::string& file, const std::string& p) const {
   CheckRange(photons_per_ms, 0, 1e9, file, p + "photons_per_ms");
   CheckRange(quantum_efficiency, 0, 1, file, p + "quantum_efficiency");
+  CheckRange(quantum_efficiency_940, 0, 1, file, p + "quantum_efficiency_940");
   CheckRange(full_well_e, 1, 1e7, file, p + "full_well_e");
   CheckRange(system_gain_dn_per_e, 1e-6, 1e3, file, p + "system_gain_dn_per_e");
   CheckRange(dark_noise_e, 0, 1e4, file, p + "dark_noise_e");
@@ -182,6 +186,7 @@ std::optional<SensorSetup> SensorPreset(const std::string& name) {
     s.sensor.black_level_dn = 0;
     // Radiance 1 at 10 ms exposure fills the 8-bit range exactly.
     s.sensor.quantum_efficiency = 1.0;
+    s.sensor.quantum_efficiency_940 = 1.0;
     s.sensor.photons_per_ms = 255.0 / (0.04 * 10.0);
     s.sensor.full_well_e = 1e7;
     return s;

@@ -19,7 +19,8 @@ struct SensorParams {
   // Photons reaching a pixel per millisecond of exposure when the rendered
   // radiance is 1 (the brightest the clean render can show).
   double photons_per_ms = 2000.0;
-  double quantum_efficiency = 0.35;   // eta, at the illuminators' wavelength
+  double quantum_efficiency = 0.35;   // eta at 850 nm
+  double quantum_efficiency_940 = 0.20;  // eta at 940 nm (silicon sees less of it)
   double full_well_e = 6000.0;        // saturation capacity, electrons
   double system_gain_dn_per_e = 0.04; // K, DN per electron
   double dark_noise_e = 10.0;         // sigma_d, temporal dark (read) noise, electrons
@@ -63,6 +64,9 @@ struct FlickerParams {
 struct CaptureParams {
   double drop_rate = 0.0;      // probability that a camera drops a frame (it repeats the last one)
   double sync_jitter_ms = 0.0; // std of a camera's capture instant around the frame time
+  // Rolling shutter: the time from the first row's exposure start to the
+  // last's; each row sees its own flicker (banding). 0: global shutter.
+  double rolling_shutter_ms = 0.0;
 };
 
 struct SensorSetup {

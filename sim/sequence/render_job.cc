@@ -262,32 +262,66 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     }
     need_depth = need_depth || setup.optics.f_number > 0;
   }
-  // Turns camera c's clean render (or its mean over the exposure's
-  // sub-frames, `radiance_sum` / `samples`) into the written frame; records
-  // the illumination level, exposure and drops in `sensor_truth`.
+  // Turns camera c's render (its radiance per source, or their mean over the
+  // exposure's sub-frames, `radiance_sum` / `samples`) into the written frame:
+  // the illuminators' light follows the mains, the screens' content light the
+  // content's flicker, each row its own with a rolling shutter; the 940 nm
+  // light counts by the sensor's relative quantum efficiency. Records the
+  // levels, exposure and drops in `sensor_truth`.
   std::vector<cv::Mat> last_written(in.rig.cameras.size());
   cv::Mat radiance;
-  auto expose = [&](size_t c, const cv::Mat& grey, const cv::Mat& radiance_sum, int samples,
-                    const cv::Mat& depth, double t, uint64_t noise_frame,
-                    nlohmann::json& sensor_truth) -> cv::Mat {
+  auto expose = [&](size_t c, const CameraImages& images, const cv::Mat& radiance_sum, int samples,
+                    double t, uint64_t noise_frame, nlohmann::json& sensor_truth) -> cv::Mat {
     const Camera& cam = in.rig.cameras[c];
     if (!in.sensor_active[c]) {
       sensor_truth[cam.name] = {{"flicker", 1.0}, {"exposure_ms", cam.exposure_ms}, {"dropped", false}};
-      return grey;
+      return images.grey;
     }
-    // The exposure is centred on the frame time, where the truth is.
+    const SensorSetup& setup = in.sensors[c];
+    // The exposure is centred on the frame time, where the truth is; with a
+    // rolling shutter, the middle row's is.
     const double exposure_s = cam.exposure_ms / 1000.0;
-    const double level = flickers[c].Level(t - 0.5 * exposure_s, exposure_s);
+    const double start_s = t - 0.5 * exposure_s;
+    const double mains = flickers[c].MainsMean(start_s, exposure_s);
+    const double screen = flickers[c].ScreenMean(start_s, exposure_s);
     const double drop_u = UniformFromHash(MixHash(options.seed, 0xD50Bull + c), noise_frame);
-    const bool dropped = drop_u < in.sensors[c].capture.drop_rate && !last_written[c].empty();
-    sensor_truth[cam.name] = {{"flicker", level}, {"exposure_ms", cam.exposure_ms}, {"dropped", dropped}};
+    const bool dropped = drop_u < setup.capture.drop_rate && !last_written[c].empty();
+    nlohmann::json& truth = sensor_truth[cam.name];
+    truth = {{"flicker", 1.0}, {"screen", screen}, {"illuminators", mains},
+             {"exposure_ms", cam.exposure_ms}, {"dropped", dropped}};
     if (dropped) return last_written[c];
-    if (samples > 1) {
-      radiance = radiance_sum * (level / (255.0 * samples));
+    const cv::Mat sources = samples > 1 ? cv::Mat(radiance_sum / samples) : images.radiance;
+    const double qe = setup.sensor.quantum_efficiency;
+    const float q940 = qe > 0 ? static_cast<float>(setup.sensor.quantum_efficiency_940 / qe) : 0.0f;
+    const float q_content = 0.5f * (1.0f + q940);
+    const double readout_s = setup.capture.rolling_shutter_ms / 1000.0;
+    const cv::Scalar mean = cv::mean(sources);
+    const double steady = mean[0] + q940 * mean[1] + q_content * mean[2] + mean[3];
+    double lit = 0;
+    if (readout_s <= 0 || sources.rows < 2) {
+      const float m = static_cast<float>(mains), s = static_cast<float>(screen);
+      const cv::Matx14f weights(m, m * q940, s * q_content, 1.0f);
+      cv::transform(sources, radiance, weights);
+      lit = mains * (mean[0] + q940 * mean[1]) + screen * q_content * mean[2] + mean[3];
     } else {
-      grey.convertTo(radiance, CV_32F, level / 255.0);
+      radiance.create(sources.size(), CV_32FC1);
+      for (int y = 0; y < sources.rows; ++y) {
+        const double row_start = start_s + (double(y) / (sources.rows - 1) - 0.5) * readout_s;
+        const float m = static_cast<float>(flickers[c].MainsMean(row_start, exposure_s));
+        const float s = static_cast<float>(flickers[c].ScreenMean(row_start, exposure_s));
+        const cv::Vec4f* in_row = sources.ptr<cv::Vec4f>(y);
+        float* out_row = radiance.ptr<float>(y);
+        double row_sum = 0;
+        for (int x = 0; x < sources.cols; ++x) {
+          const cv::Vec4f& v = in_row[x];
+          out_row[x] = m * (v[0] + q940 * v[1]) + s * q_content * v[2] + v[3];
+          row_sum += out_row[x];
+        }
+        lit += row_sum / (double(sources.rows) * sources.cols);
+      }
     }
-    const cv::Mat seen = optics[c].Apply(radiance, depth);
+    truth["flicker"] = steady > 0 ? lit / steady : 1.0;
+    const cv::Mat seen = optics[c].Apply(radiance, images.depth);
     last_written[c] = sensors[c].ToOutput(sensors[c].Expose(seen, cam.exposure_ms, noise_frame));
     return last_written[c];
   };
@@ -302,8 +336,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const cv::Mat frame = expose(c, all_images[c].grey, cv::Mat(), 1, all_images[c].depth, t,
-                                   (1ull << 40) + f, sensor_truth);
+      const cv::Mat frame = expose(c, all_images[c], cv::Mat(), 1, t, (1ull << 40) + f, sensor_truth);
       WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }
     background_lines += nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";
@@ -343,10 +376,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
       instant[c] = t + jitter_s * z0;
       jittered = true;
     }
-    auto accumulate = [&](size_t c, const cv::Mat& grey) {
-      cv::Mat g;
-      grey.convertTo(g, CV_32F);
-      if (radiance_sums[c].empty()) radiance_sums[c] = g; else radiance_sums[c] += g;
+    auto accumulate = [&](size_t c, const cv::Mat& sources) {
+      if (radiance_sums[c].empty()) radiance_sums[c] = sources.clone(); else radiance_sums[c] += sources;
     };
     for (cv::Mat& sum : radiance_sums) sum.release();
     if (!jittered) {
@@ -354,11 +385,11 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
       for (double offset : offsets) {
         PoseAndUpload(in, t + offset, renderer, skinned);
         renderer.RenderAll(&all_images, false);
-        for (size_t c = 0; c < all_images.size(); ++c) accumulate(c, all_images[c].grey);
+        for (size_t c = 0; c < all_images.size(); ++c) accumulate(c, all_images[c].radiance);
       }
       PoseAndUpload(in, t, renderer, skinned);
       renderer.RenderAll(&all_images, need_depth);
-      for (size_t c = 0; centre_counts && c < all_images.size(); ++c) accumulate(c, all_images[c].grey);
+      for (size_t c = 0; centre_counts && c < all_images.size(); ++c) accumulate(c, all_images[c].radiance);
     } else {
       // Each camera sees the person at its own instant (skinned per camera).
       all_images.resize(in.rig.cameras.size());
@@ -366,11 +397,11 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
         for (double offset : offsets) {
           PoseAndUpload(in, instant[c] + offset, renderer, skinned);
           renderer.Render(static_cast<int>(c), &all_images[c], false);
-          accumulate(c, all_images[c].grey);
+          accumulate(c, all_images[c].radiance);
         }
         PoseAndUpload(in, instant[c], renderer, skinned);
         renderer.Render(static_cast<int>(c), &all_images[c], need_depth);
-        if (centre_counts) accumulate(c, all_images[c].grey);
+        if (centre_counts) accumulate(c, all_images[c].radiance);
       }
     }
     const JointTransforms world_from_joint =
@@ -378,8 +409,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const std::string& cam_name = in.rig.cameras[c].name;
-      const cv::Mat frame = expose(c, all_images[c].grey, radiance_sums[c], blur_samples,
-                                   all_images[c].depth, instant[c], f, sensor_truth);
+      const cv::Mat frame = expose(c, all_images[c], radiance_sums[c], blur_samples, instant[c], f, sensor_truth);
       sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
       WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
       WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);

@@ -1,0 +1,189 @@
+#include "sim/lighting/bounce.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core.hpp>
+
+namespace irbench {
+namespace {
+
+// The renderer's direct light (its fragment shader's formula, in double).
+double DirectIrradiance(const IrLight& light, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+  const Eigen::Vector3d to_light = light.position - p;
+  const double dist2 = to_light.squaredNorm();
+  if (dist2 <= 0) return 0;
+  const Eigen::Vector3d l = to_light / std::sqrt(dist2);
+  const double c = (-l).dot(light.direction);
+  const double cos_half = std::cos(light.cone_deg * M_PI / 360.0);
+  const double a = cos_half - 0.05, b = cos_half + 0.05;
+  const double u = std::clamp((c - a) / (b - a), 0.0, 1.0);
+  const double cone = u * u * (3 - 2 * u);
+  const double lambert = std::max(n.dot(l), 0.0);
+  return light.power * cone * lambert / std::max(dist2, 0.25);
+}
+
+int Channel(const IrLight& light) { return light.wavelength_nm == 940.0 ? kIlluminator940 : kIlluminator850; }
+
+// Reflectance for each channel; the content light is broadband: the mean.
+Eigen::Vector3f ChannelReflectance(const NirReflectance& r) {
+  return {r.at_850, r.at_940, 0.5f * (r.at_850 + r.at_940)};
+}
+
+// Light from patch `k` onto a point `p` facing `n` (n unit; cosines clamped).
+inline double Transfer(const BouncePatch& k, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+  const Eigen::Vector3d d = k.center - p;  // point -> patch
+  const double r2 = d.squaredNorm();
+  if (r2 <= 1e-12) return 0;
+  const double r = std::sqrt(r2);
+  const double cos_p = -k.normal.dot(d) / r;
+  const double cos_x = n.dot(d) / r;
+  if (cos_p <= 0 || cos_x <= 0) return 0;
+  return k.area * cos_p * cos_x / (M_PI * r2 + k.area);
+}
+
+}  // namespace
+
+std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
+                                       const std::vector<IrLight>& lights,
+                                       const BounceOptions& options) {
+  std::vector<BouncePatch> patches;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const MeshVertex& v0 = mesh.vertices[mesh.indices[t]];
+    const MeshVertex& v1 = mesh.vertices[mesh.indices[t + 1]];
+    const MeshVertex& v2 = mesh.vertices[mesh.indices[t + 2]];
+    if (v0.emissive > 0.5f) continue;
+    const Eigen::Vector3d a = v0.position.cast<double>(), b = v1.position.cast<double>(),
+                          c = v2.position.cast<double>();
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    if (cross.norm() < 1e-12) continue;
+    // The surface faces where its vertex normals point (rooms inwards).
+    Eigen::Vector3d normal = cross.normalized();
+    const Eigen::Vector3d vertex_normal = (v0.normal + v1.normal + v2.normal).cast<double>();
+    if (normal.dot(vertex_normal) < 0) normal = -normal;
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int n = std::max(1, static_cast<int>(std::ceil(longest / options.patch_m)));
+    const double area = 0.5 * cross.norm() / (n * n);
+    // n² similar sub-triangles: (i, j) "up" and, where room, "down" ones.
+    auto add = [&](const Eigen::Vector3d& centroid) {
+      BouncePatch p;
+      p.center = centroid;
+      p.normal = normal;
+      p.area = area;
+      p.reflectance = v0.Reflectance();
+      p.content = v0.content;
+      patches.push_back(p);
+    };
+    const Eigen::Vector3d du = (b - a) / n, dv = (c - a) / n;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; i + j < n; ++j) {
+        const Eigen::Vector3d o = a + i * du + j * dv;
+        add(o + (du + dv) / 3.0);
+        if (i + j + 1 < n) add(o + 2.0 * (du + dv) / 3.0);
+      }
+    }
+  }
+  // Direct light and content emission, then gathers.
+  std::vector<Eigen::Vector3f> direct(patches.size());
+  for (size_t k = 0; k < patches.size(); ++k) {
+    Eigen::Vector3d e = Eigen::Vector3d::Zero();
+    for (const IrLight& light : lights) e[Channel(light)] += DirectIrradiance(light, patches[k].center, patches[k].normal);
+    direct[k] = e.cast<float>();
+    patches[k].radiosity = ChannelReflectance(patches[k].reflectance).cwiseProduct(direct[k]);
+    patches[k].radiosity[kScreenContent] += patches[k].content;
+  }
+  for (int bounce = 1; bounce < options.bounces; ++bounce) {
+    std::vector<Eigen::Vector3f> next(patches.size());
+    cv::parallel_for_(cv::Range(0, static_cast<int>(patches.size())), [&](const cv::Range& range) {
+      for (int j = range.start; j < range.end; ++j) {
+        Eigen::Vector3d gathered = Eigen::Vector3d::Zero();
+        for (const BouncePatch& k : patches) {
+          const double f = Transfer(k, patches[j].center, patches[j].normal);
+          if (f > 0) gathered += f * k.radiosity.cast<double>();
+        }
+        next[j] = ChannelReflectance(patches[j].reflectance).cwiseProduct(direct[j] + gathered.cast<float>());
+        next[j][kScreenContent] += patches[j].content;
+      }
+    });
+    for (size_t k = 0; k < patches.size(); ++k) patches[k].radiosity = next[k];
+  }
+  return patches;
+}
+
+IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
+                               const std::vector<IrLight>& lights,
+                               const BounceOptions& options) {
+  IrradianceVolume volume;
+  std::vector<BouncePatch> patches = BouncePatches(mesh, lights, options);
+  // Patches with no light give none.
+  patches.erase(std::remove_if(patches.begin(), patches.end(),
+                               [](const BouncePatch& p) { return p.radiosity.maxCoeff() <= 0; }),
+                patches.end());
+  if (patches.empty() || mesh.vertices.empty()) return volume;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const MeshVertex& v : mesh.vertices) {
+    lo = lo.cwiseMin(v.position.cast<double>());
+    hi = hi.cwiseMax(v.position.cast<double>());
+  }
+  volume.spacing = options.grid_m;
+  for (int k = 0; k < 3; ++k) {
+    volume.dims[k] = std::max(2, static_cast<int>(std::ceil((hi[k] - lo[k]) / options.grid_m - 1e-9)) + 1);
+  }
+  // Centre the grid on the bounds.
+  volume.origin = 0.5 * (lo + hi) - 0.5 * options.grid_m * (volume.dims.cast<double>() - Eigen::Vector3d::Ones());
+  const int nx = volume.dims.x(), ny = volume.dims.y(), nz = volume.dims.z();
+  const size_t points = size_t(nx) * ny * nz;
+  volume.values.assign(6 * points, Eigen::Vector3f::Zero());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(points)), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const int x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
+      const Eigen::Vector3d p = volume.origin + options.grid_m * Eigen::Vector3d(x, y, z);
+      Eigen::Vector3d e[6];
+      for (auto& v : e) v.setZero();
+      for (const BouncePatch& k : patches) {
+        const Eigen::Vector3d d = k.center - p;
+        const double r2 = d.squaredNorm();
+        if (r2 <= 1e-12) continue;
+        const double r = std::sqrt(r2);
+        const double cos_p = -k.normal.dot(d) / r;
+        if (cos_p <= 0) continue;
+        const double w = k.area * cos_p / ((M_PI * r2 + k.area) * r);  // times d·axis
+        const Eigen::Vector3d light = w * k.radiosity.cast<double>();
+        for (int axis = 0; axis < 3; ++axis) {
+          const double c = d[axis];
+          if (c > 0) e[2 * axis] += c * light; else e[2 * axis + 1] -= c * light;
+        }
+      }
+      for (int dir = 0; dir < 6; ++dir) volume.values[dir * points + i] = e[dir].cast<float>();
+    }
+  });
+  return volume;
+}
+
+Eigen::Vector3f IrradianceVolume::Irradiance(const Eigen::Vector3d& p, const Eigen::Vector3d& normal) const {
+  if (empty()) return Eigen::Vector3f::Zero();
+  const size_t points = size_t(dims.x()) * dims.y() * dims.z();
+  const Eigen::Vector3d g = (p - origin) / spacing;
+  int i0[3];
+  double f[3];
+  for (int k = 0; k < 3; ++k) {
+    const double c = std::clamp(g[k], 0.0, double(dims[k] - 1));
+    i0[k] = std::min(static_cast<int>(std::floor(c)), dims[k] - 2);
+    f[k] = c - i0[k];
+  }
+  const Eigen::Vector3d n = normal.normalized();
+  Eigen::Vector3f total = Eigen::Vector3f::Zero();
+  for (int axis = 0; axis < 3; ++axis) {
+    const int dir = 2 * axis + (n[axis] >= 0 ? 0 : 1);
+    Eigen::Vector3f e = Eigen::Vector3f::Zero();
+    for (int corner = 0; corner < 8; ++corner) {
+      const int cx = corner & 1, cy = (corner >> 1) & 1, cz = (corner >> 2) & 1;
+      const double w = (cx ? f[0] : 1 - f[0]) * (cy ? f[1] : 1 - f[1]) * (cz ? f[2] : 1 - f[2]);
+      const size_t index = (size_t(i0[2] + cz) * dims.y() + (i0[1] + cy)) * dims.x() + (i0[0] + cx);
+      e += static_cast<float>(w) * values[dir * points + index];
+    }
+    total += static_cast<float>(n[axis] * n[axis]) * e;
+  }
+  return total;
+}
+
+}  // namespace irbench

@@ -1,0 +1,113 @@
+// The bounce light against analytic view factors: a uniformly emitting square
+// seen from a point on its axis, a patch's direct light, one gather between
+// two facing plates, and the wavelength bands.
+
+#include "sim/lighting/bounce.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace irbench {
+namespace {
+
+// View factor from a differential area parallel to a rectangle, on the normal
+// through one of its corners, at distance h (X = a / h, Y = b / h).
+double CornerViewFactor(double a, double b, double h) {
+  const double x = a / h, y = b / h;
+  return (x / std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) +
+          y / std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y))) /
+         (2 * M_PI);
+}
+
+// Irradiance at height h above the centre of a square of side s whose
+// radiosity is B (renderer units: E = B F).
+double SquareAxisIrradiance(double radiosity, double side, double h) {
+  return radiosity * 4 * CornerViewFactor(side / 2, side / 2, h);
+}
+
+Material ContentEmitter(float content) {
+  Material m;
+  m.albedo = 0.0f;
+  m.content = content;
+  return m;
+}
+
+TEST(BounceTest, EmittingSquareMatchesItsViewFactor) {
+  TriangleMesh mesh;
+  // A 2 m square at z = 0 facing up, emitting content radiance 0.8.
+  AppendQuad(mesh, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, ContentEmitter(0.8f));
+  // A black ceiling only to extend the volume's bounds.
+  AppendQuad(mesh, {-1, -1, 3}, {0, 2, 0}, {2, 0, 0}, Material{0.0f, 0.0f});
+  BounceOptions options;
+  options.patch_m = 0.05;
+  options.grid_m = 0.25;
+  const IrradianceVolume volume = ComputeBounce(mesh, {}, options);
+  ASSERT_FALSE(volume.empty());
+  for (double h : {0.5, 1.0, 2.0}) {
+    const double expected = SquareAxisIrradiance(0.8, 2.0, h);
+    const Eigen::Vector3f e = volume.Irradiance({0, 0, h}, {0, 0, -1});
+    EXPECT_NEAR(e[kScreenContent], expected, 0.02 * expected) << "h " << h;
+    EXPECT_EQ(e[kIlluminator850], 0.0f);
+    // Facing away from the square, or sideways, a point gets (almost) nothing
+    // from it: sideways only the grazing share, none facing up.
+    EXPECT_EQ(volume.Irradiance({0, 0, h}, {0, 0, 1})[kScreenContent], 0.0f);
+    std::printf("h %.1f m: irradiance %.5f, view factor predicts %.5f\n", h, e[kScreenContent], expected);
+  }
+}
+
+TEST(BounceTest, PatchesCarryTheRenderersDirectLightPerWavelength) {
+  TriangleMesh mesh;
+  Material floor;
+  floor.albedo = 0.6f;
+  floor.albedo_940 = 0.3f;
+  AppendQuad(mesh, {-2, -2, 0}, {4, 0, 0}, {0, 4, 0}, floor);
+  IrLight light;
+  light.position = {0, 0, 2};
+  light.direction = {0, 0, -1};
+  light.cone_deg = 170;
+  light.power = 4;
+  light.wavelength_nm = 940;
+  BounceOptions options;
+  options.patch_m = 0.2;
+  options.bounces = 1;
+  const std::vector<BouncePatch> patches = BouncePatches(mesh, {light}, options);
+  ASSERT_GT(patches.size(), 100u);
+  double area = 0;
+  for (const BouncePatch& p : patches) {
+    area += p.area;
+    const Eigen::Vector3d to_light = light.position - p.center;
+    const double e = light.power * to_light.normalized().z() / to_light.squaredNorm();
+    EXPECT_NEAR(p.radiosity[kIlluminator940], 0.3 * e, 1e-5 * e);
+    EXPECT_EQ(p.radiosity[kIlluminator850], 0.0f);
+    EXPECT_EQ(p.normal.z(), 1.0);
+  }
+  EXPECT_NEAR(area, 16.0, 1e-9);
+}
+
+TEST(BounceTest, SecondBounceGathersFromTheFacingPlate) {
+  // Plate A (z = 0, up) emits; plate B (z = 1, down) reflects half of what
+  // reaches it; B's centre patch then has radiosity 0.5 E_A(centre).
+  TriangleMesh mesh;
+  AppendQuad(mesh, {-1.5, -1.5, 0}, {3, 0, 0}, {0, 3, 0}, ContentEmitter(1.0f));
+  AppendQuad(mesh, {-1.5, -1.5, 1}, {0, 3, 0}, {3, 0, 0}, Material{0.5f, 0.0f});
+  BounceOptions options;
+  options.patch_m = 0.1;
+  options.bounces = 2;
+  const std::vector<BouncePatch> patches = BouncePatches(mesh, {}, options);
+  const BouncePatch* centre = nullptr;
+  for (const BouncePatch& p : patches) {
+    if (p.center.z() > 0.5 && (!centre || p.center.head<2>().norm() < centre->center.head<2>().norm())) centre = &p;
+  }
+  ASSERT_NE(centre, nullptr);
+  ASSERT_LT(centre->center.head<2>().norm(), 0.05);
+  const double expected = 0.5 * SquareAxisIrradiance(1.0, 3.0, 1.0);
+  EXPECT_NEAR(centre->radiosity[kScreenContent], expected, 0.02 * expected);
+  options.bounces = 1;
+  for (const BouncePatch& p : BouncePatches(mesh, {}, options)) {
+    if (p.center.z() > 0.5) EXPECT_EQ(p.radiosity[kScreenContent], 0.0f);
+  }
+}
+
+}  // namespace
+}  // namespace irbench

@@ -1,0 +1,149 @@
+// The near-IR illumination through the whole render path: the illuminators'
+// light follows the mains, the screens' content light the content's flicker,
+// each on its own; a rolling shutter bands the mains row by row. Cameras
+// are set up to read radiance exactly (no noise, linear 16-bit DN).
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "sim/sensor/flicker.h"
+#include "sim/sequence/render_job.h"
+#include "tests/test_util.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+using irbench::testing::FreshTempDir;
+using irbench::testing::ReadText;
+using irbench::testing::WriteText;
+
+// A camera override that reads radiance without noise: 16-bit linear DN,
+// 51,000 DN at radiance 1 over the rig's 8 ms, no dark signal.
+nlohmann::json ExactSensor(const nlohmann::json& flicker, const nlohmann::json& capture) {
+  return {{"sensor",
+           {{"noise", false}, {"bit_depth", 16}, {"system_gain_dn_per_e", 10.0}, {"full_well_e", 1e7},
+            {"dark_current_e_per_s", 0.0}}},
+          {"flicker", flicker},
+          {"capture", capture}};
+}
+
+std::vector<nlohmann::json> ReadLines(const fs::path& path) {
+  std::vector<nlohmann::json> lines;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
+
+// An empty theater stage (background frames) whose side camera sees both the
+// illuminators' light and the screen's content light, both flickering: each
+// frame's mean is a m(t) + b s(t) with the truth's levels, both sources show,
+// and the truth's "flicker" is that mean over a + b.
+TEST(IlluminationTest, ScreenContentAndIlluminatorsFlickerApart) {
+  const fs::path dir = FreshTempDir("illum_split");
+  auto rig = nlohmann::json::parse(ReadText(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json"));
+  rig["cameras"][3]["sensor"] = ExactSensor(
+      {{"screen_amplitude", 0.3}, {"cut_rate_hz", 40.0}, {"fade_s", 0.001}, {"mains_hz", 50.0}, {"mains_depth", 0.4}},
+      nlohmann::json::object());
+  WriteText(dir / "rig.json", rig.dump());
+  RenderJobOptions options;
+  options.rig = (dir / "rig.json").string();
+  options.motion = "stand";
+  options.frames = 1;
+  options.background_frames = 40;
+  options.out = dir / "seq";
+  const fs::path seq = RunRenderJob(options);
+  const std::vector<nlohmann::json> truth = ReadLines(seq / "truth/background.jsonl");
+  ASSERT_EQ(truth.size(), 40u);
+  Eigen::MatrixXd a(40, 2);
+  Eigen::VectorXd mean(40), recorded(40);
+  double m_lo = 9, m_hi = 0, s_lo = 9, s_hi = 0;
+  for (int f = 0; f < 40; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "background/side/%06d.png", f);
+    const cv::Mat image = cv::imread((seq / name).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(image.type(), CV_16UC1);
+    const nlohmann::json& s = truth[f]["sensor"]["side"];
+    const double m = s["illuminators"], screen = s["screen"];
+    a(f, 0) = m;
+    a(f, 1) = screen;
+    mean[f] = cv::mean(image)[0];
+    recorded[f] = s["flicker"];
+    m_lo = std::min(m_lo, m), m_hi = std::max(m_hi, m), s_lo = std::min(s_lo, screen), s_hi = std::max(s_hi, screen);
+  }
+  // The levels vary independently and enough to separate the sources.
+  ASSERT_GT(m_hi - m_lo, 0.1);
+  ASSERT_GT(s_hi - s_lo, 0.3);
+  const Eigen::Vector2d ab = a.colPivHouseholderQr().solve(mean);
+  const Eigen::VectorXd residual = a * ab - mean;
+  const double rms = std::sqrt(residual.squaredNorm() / 40);
+  EXPECT_LT(rms, 0.002 * mean.mean()) << "residual " << rms;
+  EXPECT_GT(ab[0], 0.1 * ab.sum()) << "the illuminators' light";
+  EXPECT_GT(ab[1], 0.1 * ab.sum()) << "the screen's content light";
+  for (int f = 0; f < 40; ++f) EXPECT_NEAR(recorded[f], mean[f] / ab.sum(), 0.003) << "frame " << f;
+  std::printf("side camera, empty stage: mean DN = %.1f m + %.1f s (content share %.2f), residual rms %.2f DN\n",
+              ab[0], ab[1], ab[1] / ab.sum(), rms);
+}
+
+// A room lit by one illuminator on a 100 Hz supply, read by a camera whose
+// rolling shutter spans 20 ms: each row's level against the same render
+// without the mains modulation is the mains' mean over that row's exposure.
+TEST(IlluminationTest, RollingShutterBandsFollowTheMains) {
+  const fs::path dir = FreshTempDir("illum_rolling");
+  WriteText(dir / "room.json", R"({"format": "irbench.scene/1", "name": "room", "ambient": 0.0, "bounce": false,
+    "objects": [{"type": "room", "name": "hall", "min": [-5, -5, 0], "max": [5, 5, 4],
+                 "floor": 0.5, "ceiling": 0.5, "walls": 0.5}],
+    "lights": [{"name": "lamp", "position": [0, -3, 3.5], "look_at": [0, 0, 0], "cone_deg": 170,
+                "power": 8, "shadows": false}]})");
+  const nlohmann::json mains = {{"mains_hz", 100.0}, {"mains_depth", 0.5}};
+  auto render = [&](const std::string& name, const nlohmann::json& flicker, const nlohmann::json& capture) {
+    auto rig = nlohmann::json::parse(ReadText(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json"));
+    rig["cameras"][3]["sensor"] = ExactSensor(flicker, capture);
+    WriteText(dir / (name + "_rig.json"), rig.dump());
+    RenderJobOptions options;
+    options.rig = (dir / (name + "_rig.json")).string();
+    options.scene = (dir / "room.json").string();
+    options.motion = "stand";
+    options.frames = 1;
+    options.background_frames = 2;
+    options.out = dir / name;
+    const fs::path seq = RunRenderJob(options);
+    cv::Mat image = cv::imread((seq / "background/side/000001.png").string(), cv::IMREAD_UNCHANGED);
+    image.convertTo(image, CV_64F);
+    return image;
+  };
+  const cv::Mat steady = render("steady", nlohmann::json::object(), nlohmann::json::object());
+  const cv::Mat rolling = render("rolling", mains, {{"rolling_shutter_ms", 20.0}});
+  const cv::Mat global = render("global", mains, nlohmann::json::object());
+  // The same flicker model the render used: seed 1, from the first background frame.
+  const double fps = 30;
+  FlickerParams params;
+  params.mains_hz = 100;
+  params.mains_depth = 0.5;
+  const FlickerModel flicker(params, 1, -2 / fps, 1 / fps);
+  const double exposure_s = 0.008, t = 1 / fps - 2 / fps;
+  double lo = 9, hi = 0, worst = 0, global_spread = 0;
+  const double global_level = cv::sum(global)[0] / cv::sum(steady)[0];
+  for (int y = 0; y < steady.rows; ++y) {
+    const double row = cv::sum(rolling.row(y))[0] / cv::sum(steady.row(y))[0];
+    const double row_start = t - 0.5 * exposure_s + (double(y) / (steady.rows - 1) - 0.5) * 0.020;
+    const double expected = flicker.MainsMean(row_start, exposure_s);
+    worst = std::max(worst, std::abs(row - expected));
+    lo = std::min(lo, row), hi = std::max(hi, row);
+    global_spread = std::max(global_spread,
+                             std::abs(cv::sum(global.row(y))[0] / cv::sum(steady.row(y))[0] - global_level));
+  }
+  EXPECT_LT(worst, 0.002);
+  EXPECT_GT(hi - lo, 0.15) << "bands";
+  EXPECT_LT(global_spread, 0.001) << "a global shutter has no bands";
+  EXPECT_NEAR(global_level, flicker.MainsMean(t - 0.5 * exposure_s, exposure_s), 0.002);
+  std::printf("rolling shutter: row levels %.3f..%.3f, worst row off the mains model by %.5f\n", lo, hi, worst);
+}
+
+}  // namespace
+}  // namespace irbench
