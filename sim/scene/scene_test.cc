@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+
+#include "common/error.h"
+#include "sim/scene/materials.h"
 
 namespace irbench {
 namespace {
@@ -78,6 +82,53 @@ TEST(SceneTest, PlaneScreenIsHitOnlyFromTheFront) {
   EXPECT_NEAR(hit->x(), 1.0, 1e-12);
   EXPECT_NEAR(hit->y(), 0.5, 1e-12);
   EXPECT_FALSE(screen.Intersect({0, 5, 1}, {0, -1, 0}).has_value());
+}
+
+}  // namespace
+}  // namespace irbench
+
+namespace irbench {
+namespace {
+
+std::filesystem::path WriteScene(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("irbench_scene_test_" + name + ".json");
+  std::ofstream(path) << text;
+  return path;
+}
+
+// Reflectances: a number is grey, a name comes from the table, a pair gives
+// both wavelengths; a screen's content light is read; bad values name the field.
+TEST(SceneMaterialTest, NamesPairsAndNumbers) {
+  const auto path = WriteScene("materials", R"({"format": "irbench.scene/1", "name": "m", "bounce": {"bounces": 1},
+    "objects": [{"type": "quad", "name": "a", "origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0], "albedo": "skin_light"},
+                {"type": "quad", "name": "b", "origin": [0, 0, 1], "u": [1, 0, 0], "v": [0, 1, 0], "albedo": {"850": 0.4, "940": 0.2}},
+                {"type": "quad", "name": "c", "origin": [0, 0, 2], "u": [1, 0, 0], "v": [0, 1, 0], "albedo": 0.3}],
+    "screens": [{"name": "s", "type": "plane", "origin": [0, 3, 0], "right": [1, 0, 0], "up": [0, 0, 1],
+                 "width": 2, "height": 1, "albedo": "projection_screen", "content_radiance": 0.4}]})");
+  const Scene scene = LoadScene(path);
+  EXPECT_EQ(scene.bounce.bounces, 1);
+  EXPECT_EQ(scene.mesh.vertices[0].Reflectance(), *FindNirMaterial("skin_light"));
+  EXPECT_EQ(scene.mesh.vertices[4].Reflectance(), (NirReflectance{0.4f, 0.2f}));
+  EXPECT_EQ(scene.mesh.vertices[8].Reflectance(), NirReflectance::Grey(0.3f));
+  EXPECT_FLOAT_EQ(scene.mesh.vertices[12].content, 0.4f);
+  EXPECT_EQ(scene.mesh.vertices[12].Reflectance(), *FindNirMaterial("projection_screen"));
+  for (const NirMaterial& m : NirMaterials()) {
+    EXPECT_GT(m.reflectance.at_850, 0.0f) << m.name;
+    EXPECT_LE(m.reflectance.at_850, 1.0f) << m.name;
+    EXPECT_LE(m.reflectance.at_940, 1.0f) << m.name;
+  }
+  auto error_of = [](const std::string& name, const std::string& albedo) {
+    try {
+      LoadScene(WriteScene(name, R"({"format": "irbench.scene/1", "objects": [{"type": "quad", "name": "a",
+        "origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0], "albedo": )" + albedo + "}]}"));
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of("unknown", "\"velvet_purple\""), "objects[0].albedo");
+  EXPECT_EQ(error_of("range", "{\"850\": 0.4, \"940\": 1.2}"), "objects[0].albedo.940");
+  EXPECT_EQ(error_of("key", "{\"850\": 0.4, \"900\": 0.2}"), "objects[0].albedo.900");
 }
 
 }  // namespace
