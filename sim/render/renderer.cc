@@ -1,5 +1,6 @@
 #include "sim/render/renderer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -15,11 +16,31 @@ layout(location = 2) in vec2 a_material;  // albedo (850 nm), emissive
 layout(location = 3) in vec2 a_extra;     // albedo at 940 nm (< 0: as 850), content emission
 uniform mat4 u_clip_from_world;
 uniform mat4 u_cam_from_world;
+uniform vec3 u_camera_center;
+// Bounce light (sim/lighting/bounce.h): irradiance onto +x, -x, +y, -y, +z, -z
+// facing surfaces, channels 850 nm / 940 nm / screen content. It varies
+// slowly, so it is read per vertex (static meshes are cut to short edges).
+uniform sampler3D u_bounce[6];
+uniform int u_bounce_on;
+uniform vec3 u_bounce_origin;
+uniform float u_bounce_spacing;
+uniform vec3 u_bounce_dims;
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_material;
 out vec2 v_extra;
+out vec3 v_bounce;
 out float v_depth;
+
+vec3 Bounce(vec3 p, vec3 n) {
+  vec3 uvw = ((p - u_bounce_origin) / u_bounce_spacing + 0.5) / u_bounce_dims;
+  vec3 n2 = n * n;
+  vec3 ex = n.x >= 0.0 ? textureLod(u_bounce[0], uvw, 0.0).rgb : textureLod(u_bounce[1], uvw, 0.0).rgb;
+  vec3 ey = n.y >= 0.0 ? textureLod(u_bounce[2], uvw, 0.0).rgb : textureLod(u_bounce[3], uvw, 0.0).rgb;
+  vec3 ez = n.z >= 0.0 ? textureLod(u_bounce[4], uvw, 0.0).rgb : textureLod(u_bounce[5], uvw, 0.0).rgb;
+  return n2.x * ex + n2.y * ey + n2.z * ez;
+}
+
 void main() {
   vec4 p = vec4(a_position, 1.0);
   gl_Position = u_clip_from_world * p;
@@ -27,6 +48,13 @@ void main() {
   v_normal = a_normal;
   v_material = a_material;
   v_extra = a_extra;
+  v_bounce = vec3(0.0);
+  if (u_bounce_on != 0) {
+    // Two-sided: the side the camera sees.
+    vec3 n = normalize(a_normal);
+    if (dot(n, u_camera_center - a_position) < 0.0) n = -n;
+    v_bounce = Bounce(a_position, n);
+  }
   v_depth = (u_cam_from_world * p).z;
 }
 )";
@@ -36,6 +64,7 @@ in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_material;
 in vec2 v_extra;
+in vec3 v_bounce;
 in float v_depth;
 uniform float u_person;
 uniform vec3 u_camera_center;
@@ -46,13 +75,6 @@ uniform vec3 u_light_direction[8];
 uniform float u_light_cos_half[8];
 uniform float u_light_power[8];
 uniform int u_light_band[8];  // 0: 850 nm, 1: 940 nm
-// Bounce light (sim/lighting/bounce.h): irradiance onto +x, -x, +y, -y, +z, -z
-// facing surfaces, channels 850 nm / 940 nm / screen content.
-uniform sampler3D u_bounce[6];
-uniform int u_bounce_on;
-uniform vec3 u_bounce_origin;
-uniform float u_bounce_spacing;
-uniform vec3 u_bounce_dims;
 uniform int u_light_shadow_slot[8];  // -1: no shadow map
 uniform sampler2DArray u_shadow_maps;  // one layer per shadow slot
 uniform mat4 u_shadow_clip_from_world[4];
@@ -113,15 +135,6 @@ float Visibility(int slot, vec3 p) {
 }
 #endif
 
-vec3 Bounce(vec3 p, vec3 n) {
-  vec3 uvw = ((p - u_bounce_origin) / u_bounce_spacing + 0.5) / u_bounce_dims;
-  vec3 n2 = n * n;
-  vec3 ex = n.x >= 0.0 ? texture(u_bounce[0], uvw).rgb : texture(u_bounce[1], uvw).rgb;
-  vec3 ey = n.y >= 0.0 ? texture(u_bounce[2], uvw).rgb : texture(u_bounce[3], uvw).rgb;
-  vec3 ez = n.z >= 0.0 ? texture(u_bounce[4], uvw).rgb : texture(u_bounce[5], uvw).rgb;
-  return n2.x * ex + n2.y * ey + n2.z * ez;
-}
-
 void main() {
   vec3 n = normalize(v_normal);
   if (dot(n, u_camera_center - v_world) < 0.0) n = -n;  // two-sided
@@ -130,8 +143,7 @@ void main() {
     radiance.a = v_material.x;
   } else {
     // Irradiance per channel: illuminators at 850 and 940 nm, screen content.
-    vec3 irradiance = vec3(u_ambient, 0.0, 0.0);
-    if (u_bounce_on != 0) irradiance += Bounce(v_world, n);
+    vec3 irradiance = vec3(u_ambient, 0.0, 0.0) + v_bounce;
     for (int i = 0; i < u_light_count; ++i) {
       vec3 to_light = u_light_position[i] - v_world;
       float d2 = max(dot(to_light, to_light), 0.25);
@@ -246,6 +258,7 @@ void SetupVertexLayout(const GlFunctions& gl) {
 void RenderOptions::Check() const {
   if (supersample < 1 || supersample > 4) throw InputError("", "supersample", "must be in 1..4");
   if (near_m <= 0 || far_m <= near_m) throw InputError("", "near_m", "need 0 < near < far");
+  if (!(static_edge_m >= 0.05)) throw InputError("", "static_edge_m", "must be at least 0.05 m");
 }
 
 struct Renderer::ShadowMap {
@@ -257,7 +270,7 @@ struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
   cv::Mat map_x, map_y;  // output pixel -> render pixel
-  cv::Mat raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
+  cv::Mat raw_half, raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
   Eigen::Matrix4f clip_from_world;
 };
 
@@ -332,7 +345,7 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
       gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
       gl.FramebufferTexture2D(GL_FRAMEBUFFER, slot, GL_TEXTURE_2D, *tex, 0);
     };
-    make_texture(&target->grey_tex, GL_RGBA32F, GL_RGBA, GL_FLOAT, GL_COLOR_ATTACHMENT0);
+    make_texture(&target->grey_tex, GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT, GL_COLOR_ATTACHMENT0);
     make_texture(&target->mask_tex, GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT1);
     make_texture(&target->depth_tex, GL_R32F, GL_RED, GL_FLOAT, GL_COLOR_ATTACHMENT2);
     gl.GenRenderbuffers(1, &target->depth_rbo);
@@ -345,7 +358,7 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
     if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       throw RuntimeError("framebuffer incomplete for camera " + cam.name);
     }
-    target->raw_radiance.create(rc.height, rc.width, CV_32FC4);
+    target->raw_half.create(rc.height, rc.width, CV_16FC4);
     target->raw_mask.create(rc.height, rc.width, CV_8UC1);
     target->raw_depth.create(rc.height, rc.width, CV_32FC1);
     targets_.push_back(std::move(target));
@@ -436,7 +449,46 @@ void Renderer::SetBounce(const IrradianceVolume& volume) {
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while uploading the bounce light");
 }
 
-void Renderer::SetStaticMesh(const TriangleMesh& mesh) {
+namespace {
+
+// Cuts every triangle into n² similar ones, n = ceil(longest edge / max_edge),
+// so that per-vertex lighting (the bounce light) follows the surface.
+TriangleMesh Tessellated(const TriangleMesh& mesh, double max_edge) {
+  TriangleMesh out;
+  out.vertices.reserve(mesh.vertices.size());
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const MeshVertex& a = mesh.vertices[mesh.indices[t]];
+    const MeshVertex& b = mesh.vertices[mesh.indices[t + 1]];
+    const MeshVertex& c = mesh.vertices[mesh.indices[t + 2]];
+    const float longest = std::max({(b.position - a.position).norm(), (c.position - b.position).norm(),
+                                    (a.position - c.position).norm()});
+    const int n = std::max(1, static_cast<int>(std::ceil(longest / max_edge)));
+    const uint32_t base = static_cast<uint32_t>(out.vertices.size());
+    // Vertex (i, j), i + j <= n, at a + i/n (b - a) + j/n (c - a); attributes from a.
+    auto index = [&](int i, int j) { return base + static_cast<uint32_t>(i * (n + 1) - i * (i - 1) / 2 + j); };
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; i + j <= n; ++j) {
+        MeshVertex v = a;
+        const float u = float(i) / n, w = float(j) / n;
+        v.position = a.position + u * (b.position - a.position) + w * (c.position - a.position);
+        v.normal = ((1 - u - w) * a.normal + u * b.normal + w * c.normal).normalized();
+        out.vertices.push_back(v);
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; i + j < n; ++j) {
+        out.indices.insert(out.indices.end(), {index(i, j), index(i + 1, j), index(i, j + 1)});
+        if (i + j + 1 < n) out.indices.insert(out.indices.end(), {index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void Renderer::SetStaticMesh(const TriangleMesh& input) {
+  const TriangleMesh mesh = Tessellated(input, options_.static_edge_m);
   const GlFunctions& gl = gl_;
   gl.BindVertexArray(static_vao_);
   gl.BindBuffer(GL_ARRAY_BUFFER, static_vbo_);
@@ -657,7 +709,7 @@ void Renderer::Read(int index, CameraImages* out, bool want_depth) {
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RGBA, GL_FLOAT, t.raw_radiance.data);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RGBA, GL_HALF_FLOAT, t.raw_half.data);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
   gl.ReadPixels(0, 0, rc.width, rc.height, GL_RED, GL_UNSIGNED_BYTE, t.raw_mask.data);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT2);
@@ -670,6 +722,9 @@ void Renderer::Read(int index, CameraImages* out, bool want_depth) {
   // The grey image is low-passed first (a Gaussian of 0.5 output pixels, about a
   // good lens's blur) so edges fall between supersamples instead of snapping
   // to them; this keeps sub-pixel corner positions unbiased and steady.
+  // Half floats (11-bit mantissa: far below the shot noise) halve the
+  // read-back; the blur works in float.
+  t.raw_half.convertTo(t.raw_radiance, CV_32F);
   cv::GaussianBlur(t.raw_radiance, t.blurred_radiance, cv::Size(0, 0), 0.5 * options_.supersample);
   cv::remap(t.blurred_radiance, out->radiance, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   // The plain grey image: every channel at level 1, 1 = 255.

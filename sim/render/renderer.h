@@ -26,6 +26,10 @@ struct RenderOptions {
   // penumbrae from each light's size (percentage-closer soft shadows).
   bool shadows = false;
   int shadow_map_size = 1024;
+  // The bounce light is read per vertex (it varies slowly); static meshes are
+  // cut into triangles no longer than this for it. Finer costs llvmpipe more
+  // partly covered pixel blocks than it gains.
+  double static_edge_m = 2.0;
 
   // Throws InputError for bad values.
   void Check() const;
