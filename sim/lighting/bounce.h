@@ -2,8 +2,8 @@
 // Diffuse bounce light (docs/sensor.md "Bounce light"): the illuminators'
 // light reflected off the static scene — above all the screens, which the
 // illuminators face, and the floor — and the near IR the screens' projected
-// content emits, gathered into an irradiance volume the renderer samples per
-// fragment.
+// content emits, gathered into an irradiance volume the renderer reads at
+// every vertex (static meshes are cut to short edges for it).
 //
 // The static mesh is cut into patches of about `patch_m`. Each patch's
 // radiosity B = reflectance × irradiance (the renderer's radiance units:
@@ -16,6 +16,8 @@
 // B A cosθ_p cosθ_x / (π r² + A) (exact on the axis of a disc of area A).
 // Three channels, after how the sensor weighs them and how they flicker:
 // 0 the illuminators' light at 850 nm, 1 at 940 nm, 2 the screens' content.
+// A patch takes and gives light on the side its normal faces (rooms inwards,
+// boxes outwards, screens towards the audience, quads along u x v).
 // What is not modelled: occlusion between static surfaces (the patches see
 // each other through boxes) and the person's shadow in the bounce light.
 

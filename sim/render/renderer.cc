@@ -451,36 +451,47 @@ void Renderer::SetBounce(const IrradianceVolume& volume) {
 
 namespace {
 
-// Cuts every triangle into n² similar ones, n = ceil(longest edge / max_edge),
-// so that per-vertex lighting (the bounce light) follows the surface.
+// Bisects every triangle's longest edge at its midpoint until no edge exceeds
+// `max_edge`, so that per-vertex lighting (the bounce light) follows the
+// surface. Whether an edge is split depends only on its length, so triangles
+// sharing an edge split it at the same points: no T-junctions, no cracks.
+void Bisect(const MeshVertex& a, const MeshVertex& b, const MeshVertex& c, float max_edge, TriangleMesh& out) {
+  const float ab = (b.position - a.position).squaredNorm(), bc = (c.position - b.position).squaredNorm(),
+              ca = (a.position - c.position).squaredNorm();
+  const float longest = std::max({ab, bc, ca});
+  if (longest <= max_edge * max_edge) {
+    const uint32_t base = static_cast<uint32_t>(out.vertices.size());
+    out.vertices.insert(out.vertices.end(), {a, b, c});
+    out.indices.insert(out.indices.end(), {base, base + 1, base + 2});
+    return;
+  }
+  auto midpoint = [](const MeshVertex& p, const MeshVertex& q) {
+    MeshVertex m = p;
+    m.position = 0.5f * (p.position + q.position);
+    m.normal = (p.normal + q.normal).normalized();
+    return m;
+  };
+  // Keep the winding: split the longest edge, each half with the opposite vertex.
+  if (longest == ab) {
+    const MeshVertex m = midpoint(a, b);
+    Bisect(a, m, c, max_edge, out);
+    Bisect(m, b, c, max_edge, out);
+  } else if (longest == bc) {
+    const MeshVertex m = midpoint(b, c);
+    Bisect(a, b, m, max_edge, out);
+    Bisect(a, m, c, max_edge, out);
+  } else {
+    const MeshVertex m = midpoint(c, a);
+    Bisect(a, b, m, max_edge, out);
+    Bisect(m, b, c, max_edge, out);
+  }
+}
+
 TriangleMesh Tessellated(const TriangleMesh& mesh, double max_edge) {
   TriangleMesh out;
-  out.vertices.reserve(mesh.vertices.size());
   for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-    const MeshVertex& a = mesh.vertices[mesh.indices[t]];
-    const MeshVertex& b = mesh.vertices[mesh.indices[t + 1]];
-    const MeshVertex& c = mesh.vertices[mesh.indices[t + 2]];
-    const float longest = std::max({(b.position - a.position).norm(), (c.position - b.position).norm(),
-                                    (a.position - c.position).norm()});
-    const int n = std::max(1, static_cast<int>(std::ceil(longest / max_edge)));
-    const uint32_t base = static_cast<uint32_t>(out.vertices.size());
-    // Vertex (i, j), i + j <= n, at a + i/n (b - a) + j/n (c - a); attributes from a.
-    auto index = [&](int i, int j) { return base + static_cast<uint32_t>(i * (n + 1) - i * (i - 1) / 2 + j); };
-    for (int i = 0; i <= n; ++i) {
-      for (int j = 0; i + j <= n; ++j) {
-        MeshVertex v = a;
-        const float u = float(i) / n, w = float(j) / n;
-        v.position = a.position + u * (b.position - a.position) + w * (c.position - a.position);
-        v.normal = ((1 - u - w) * a.normal + u * b.normal + w * c.normal).normalized();
-        out.vertices.push_back(v);
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; i + j < n; ++j) {
-        out.indices.insert(out.indices.end(), {index(i, j), index(i + 1, j), index(i, j + 1)});
-        if (i + j + 1 < n) out.indices.insert(out.indices.end(), {index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
-      }
-    }
+    Bisect(mesh.vertices[mesh.indices[t]], mesh.vertices[mesh.indices[t + 1]], mesh.vertices[mesh.indices[t + 2]],
+           static_cast<float>(max_edge), out);
   }
   return out;
 }

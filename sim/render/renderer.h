@@ -1,6 +1,6 @@
 #pragma once
 // The off-screen renderer: every camera into its own framebuffer, in one pass
-// with three targets (grey shading, person mask, camera depth), at a
+// with three targets (radiance per light source, person mask, camera depth), at a
 // supersampled pinhole resolution wide enough to cover the distorted image,
 // then resampled through the camera's exact Brown–Conrady distortion on the
 // CPU (docs/truth.md). The person mesh is uploaded once per frame and drawn by every camera.

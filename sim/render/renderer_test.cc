@@ -247,7 +247,10 @@ Camera DownCamera() {
 
 cv::Vec4f RadianceAt(const CameraImages& images, const Camera& cam, const Eigen::Vector3d& p) {
   const Eigen::Vector2d px = cam.Project(p);
-  return images.radiance.at<cv::Vec4f>(static_cast<int>(std::lround(px.y())), static_cast<int>(std::lround(px.x())));
+  const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+  EXPECT_TRUE(u >= 0 && v >= 0 && u < images.radiance.cols && v < images.radiance.rows) << p.transpose();
+  if (u < 0 || v < 0 || u >= images.radiance.cols || v >= images.radiance.rows) return cv::Vec4f(-1, -1, -1, -1);
+  return images.radiance.at<cv::Vec4f>(v, u);
 }
 
 // Each light lights in its own band, and a surface answers with its
@@ -292,8 +295,9 @@ TEST(IlluminationTest, ReflectanceFollowsTheLightsWavelength) {
 TEST(IlluminationTest, BounceLightMatchesTheIrradianceVolume) {
   auto context = CreateGlContext(GlBackend::kAuto);
   const Camera cam = DownCamera();
-  // Vertices every 0.25 m (on the test points) so the per-vertex bounce is
-  // exact there.
+  // The floor is bisected into right triangles with vertices every 0.1875 m
+  // (6 m / 32): the test points below are vertices, where the per-vertex
+  // bounce is exact.
   RenderOptions options_for_test;
   options_for_test.static_edge_m = 0.25;
   Renderer renderer(*context, {cam}, options_for_test);
@@ -304,6 +308,14 @@ TEST(IlluminationTest, BounceLightMatchesTheIrradianceVolume) {
   screen.content = 1.0f;
   // A 4 m x 2 m screen at y = 1.5 facing -y (u x v = -y).
   AppendQuad(mesh, {-2, 1.5, 0}, {4, 0, 0}, {0, 0, 2}, screen);
+  // Two small tilts, facing +x and -x (and up): they read the +x and -x
+  // samplers besides +z.
+  const Eigen::Vector3d tilt_pos(0.6, 0, 0.8), tilt_neg(-0.6, 0, 0.8);
+  const Eigen::Vector3d tilt_pos_centre(1.2, 0.375, 0.05), tilt_neg_centre(0.95, 0.375, 0.05);
+  for (const auto& [n, c] : {std::pair{tilt_pos, tilt_pos_centre}, std::pair{tilt_neg, tilt_neg_centre}}) {
+    const Eigen::Vector3d u = Eigen::Vector3d(0, 1, 0).cross(n).normalized() * 0.1, v(0, 0.1, 0);
+    AppendQuad(mesh, c - 0.5 * u - 0.5 * v, u, v, Material{0.5f, 0.0f});
+  }
   renderer.SetStaticMesh(mesh);
   renderer.SetLighting({}, 0.0);
   BounceOptions options;
@@ -314,14 +326,28 @@ TEST(IlluminationTest, BounceLightMatchesTheIrradianceVolume) {
   renderer.SetBounce(volume);
   CameraImages images;
   renderer.Render(0, &images, false);
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(0, 1.0, 0), Eigen::Vector3d(0.5, 0.25, 0), Eigen::Vector3d(-0.75, -0.5, 0)}) {
+  for (const Eigen::Vector3d p : {Eigen::Vector3d(0, 0.75, 0), Eigen::Vector3d(0.375, 0.1875, 0),
+                                  Eigen::Vector3d(-0.75, -0.375, 0)}) {
     const double expected = 0.5 * volume.Irradiance(p, Eigen::Vector3d::UnitZ())[kScreenContent];
     const cv::Vec4f r = RadianceAt(images, cam, p);
     EXPECT_GT(expected, 0.01);
-    EXPECT_NEAR(r[2], expected, 0.02 * expected) << p.transpose();
+    EXPECT_NEAR(r[2], expected, 0.01 * expected) << p.transpose();
     EXPECT_EQ(r[0] + r[1] + r[3], 0.0f);
     std::printf("floor at (%.1f, %.1f): content radiance %.4f, volume %.4f\n", p.x(), p.y(), r[2], expected);
   }
+  // The tilted faces, at their centres (0.1 m faces, linear in between).
+  double tilted[2];
+  int k = 0;
+  for (const auto& [n, c] : {std::pair{tilt_pos, tilt_pos_centre}, std::pair{tilt_neg, tilt_neg_centre}}) {
+    const double expected = 0.5 * volume.Irradiance(c, n)[kScreenContent];
+    const cv::Vec4f r = RadianceAt(images, cam, c);
+    EXPECT_NEAR(r[2], expected, 0.02 * expected) << n.transpose();
+    tilted[k++] = r[2];
+    std::printf("face tilted to (%.1f, %.1f, %.1f): content radiance %.4f, volume %.4f\n", n.x(), n.y(), n.z(), r[2],
+                expected);
+  }
+  // Beside the wall's right end, facing +x sees little of it, facing -x most.
+  EXPECT_GT(tilted[1], 1.2 * tilted[0]);
   // Off: nothing.
   renderer.SetBounce(IrradianceVolume{});
   renderer.Render(0, &images, false);

@@ -1,5 +1,6 @@
 #include "sim/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -190,6 +191,36 @@ Scene LoadScene(const std::filesystem::path& path) {
   }
   scene.mesh.Append(enclosure);
   if (scene.mesh.vertices.empty()) root.Fail("scene has no geometry");
+  if (scene.bounce.bounces > 0) {
+    // The bounce gathers patch to patch (quadratic) and sums every patch into
+    // every volume point: keep both counts where a render stays interactive.
+    double patches = 0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    for (size_t t = 0; t + 2 < scene.mesh.indices.size(); t += 3) {
+      double longest = 0;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3f d = scene.mesh.vertices[scene.mesh.indices[t + k]].position -
+                                  scene.mesh.vertices[scene.mesh.indices[t + (k + 1) % 3]].position;
+        longest = std::max(longest, double(d.norm()));
+      }
+      patches += std::pow(std::max(1.0, std::ceil(longest / scene.bounce.patch_m)), 2);
+    }
+    for (const MeshVertex& v : scene.mesh.vertices) {
+      lo = lo.cwiseMin(v.position.cast<double>());
+      hi = hi.cwiseMax(v.position.cast<double>());
+    }
+    double points = 1;
+    for (int k = 0; k < 3; ++k) points *= std::ceil((hi[k] - lo[k]) / scene.bounce.grid_m) + 1;
+    const JsonNode where = root.Has("bounce") ? root["bounce"] : root;
+    if (patches > 60000) {
+      where.Fail("the bounce light would need " + std::to_string(static_cast<long>(patches)) +
+                 " patches (at most 60000): raise patch_m");
+    }
+    if (points > 200000) {
+      where.Fail("the bounce light's volume would have " + std::to_string(static_cast<long>(points)) +
+                 " points (at most 200000): raise grid_m");
+    }
+  }
   return scene;
 }
 

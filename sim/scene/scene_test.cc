@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <unistd.h>
 
 #include "common/error.h"
 #include "sim/scene/materials.h"
@@ -91,7 +92,8 @@ namespace irbench {
 namespace {
 
 std::filesystem::path WriteScene(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("irbench_scene_test_" + name + ".json");
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("irbench_scene_test_" + std::to_string(::getpid()) + "_" + name + ".json");
   std::ofstream(path) << text;
   return path;
 }
@@ -107,11 +109,11 @@ TEST(SceneMaterialTest, NamesPairsAndNumbers) {
                  "width": 2, "height": 1, "albedo": "projection_screen", "content_radiance": 0.4}]})");
   const Scene scene = LoadScene(path);
   EXPECT_EQ(scene.bounce.bounces, 1);
-  EXPECT_EQ(scene.mesh.vertices[0].Reflectance(), *FindNirMaterial("skin_light"));
+  EXPECT_EQ(scene.mesh.vertices[0].Reflectance(), (NirReflectance{0.60f, 0.55f}));
   EXPECT_EQ(scene.mesh.vertices[4].Reflectance(), (NirReflectance{0.4f, 0.2f}));
   EXPECT_EQ(scene.mesh.vertices[8].Reflectance(), NirReflectance::Grey(0.3f));
   EXPECT_FLOAT_EQ(scene.mesh.vertices[12].content, 0.4f);
-  EXPECT_EQ(scene.mesh.vertices[12].Reflectance(), *FindNirMaterial("projection_screen"));
+  EXPECT_EQ(scene.mesh.vertices[12].Reflectance(), (NirReflectance{0.85f, 0.84f}));
   for (const NirMaterial& m : NirMaterials()) {
     EXPECT_GT(m.reflectance.at_850, 0.0f) << m.name;
     EXPECT_LE(m.reflectance.at_850, 1.0f) << m.name;
@@ -129,6 +131,27 @@ TEST(SceneMaterialTest, NamesPairsAndNumbers) {
   EXPECT_EQ(error_of("unknown", "\"velvet_purple\""), "objects[0].albedo");
   EXPECT_EQ(error_of("range", "{\"850\": 0.4, \"940\": 1.2}"), "objects[0].albedo.940");
   EXPECT_EQ(error_of("key", "{\"850\": 0.4, \"900\": 0.2}"), "objects[0].albedo.900");
+  auto scene_error = [](const std::string& name, const std::string& text) {
+    try {
+      LoadScene(WriteScene(name, text));
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string("no error");
+  };
+  const std::string quad = R"("objects": [{"type": "quad", "origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0]}])";
+  EXPECT_EQ(scene_error("content", R"({"format": "irbench.scene/1", "screens": [{"name": "s", "type": "plane",
+      "origin": [0, 3, 0], "right": [1, 0, 0], "up": [0, 0, 1], "width": 2, "height": 1, "content_radiance": -1}]})"),
+            "screens[0].content_radiance");
+  EXPECT_EQ(scene_error("bounces", R"({"format": "irbench.scene/1", "bounce": {"bounces": 9}, )" + quad + "}"),
+            "bounce.bounces");
+  EXPECT_EQ(scene_error("patch", R"({"format": "irbench.scene/1", "bounce": {"patch_m": 0.01}, )" + quad + "}"),
+            "bounce.patch_m");
+  // Too fine for the room: refused before any work, naming the bounce.
+  EXPECT_EQ(scene_error("cost", R"({"format": "irbench.scene/1", "bounce": {"patch_m": 0.05},
+      "objects": [{"type": "room", "min": [-6, -5, 0], "max": [6, 5.5, 4.2]}]})"),
+            "bounce");
+  EXPECT_EQ(scene_error("off", R"({"format": "irbench.scene/1", "bounce": false, )" + quad + "}"), "no error");
 }
 
 }  // namespace

@@ -269,12 +269,14 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   // light counts by the sensor's relative quantum efficiency. Records the
   // levels, exposure and drops in `sensor_truth`.
   std::vector<cv::Mat> last_written(in.rig.cameras.size());
+  std::vector<double> last_flicker(in.rig.cameras.size(), 1.0);  // of the image a drop repeats
   cv::Mat radiance;
   auto expose = [&](size_t c, const CameraImages& images, const cv::Mat& radiance_sum, int samples,
                     double t, uint64_t noise_frame, nlohmann::json& sensor_truth) -> cv::Mat {
     const Camera& cam = in.rig.cameras[c];
     if (!in.sensor_active[c]) {
-      sensor_truth[cam.name] = {{"flicker", 1.0}, {"exposure_ms", cam.exposure_ms}, {"dropped", false}};
+      sensor_truth[cam.name] = {{"flicker", 1.0}, {"screen", 1.0}, {"illuminators", 1.0},
+                                {"exposure_ms", cam.exposure_ms}, {"dropped", false}};
       return images.grey;
     }
     const SensorSetup& setup = in.sensors[c];
@@ -287,7 +289,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     const double drop_u = UniformFromHash(MixHash(options.seed, 0xD50Bull + c), noise_frame);
     const bool dropped = drop_u < setup.capture.drop_rate && !last_written[c].empty();
     nlohmann::json& truth = sensor_truth[cam.name];
-    truth = {{"flicker", 1.0}, {"screen", screen}, {"illuminators", mains},
+    // A dropped frame repeats the last image, and its illumination.
+    truth = {{"flicker", last_flicker[c]}, {"screen", screen}, {"illuminators", mains},
              {"exposure_ms", cam.exposure_ms}, {"dropped", dropped}};
     if (dropped) return last_written[c];
     const cv::Mat sources = samples > 1 ? cv::Mat(radiance_sum / samples) : images.radiance;
@@ -320,7 +323,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
         lit += row_sum / (double(sources.rows) * sources.cols);
       }
     }
-    truth["flicker"] = steady > 0 ? lit / steady : 1.0;
+    last_flicker[c] = steady > 0 ? lit / steady : 1.0;
+    truth["flicker"] = last_flicker[c];
     const cv::Mat seen = optics[c].Apply(radiance, images.depth);
     last_written[c] = sensors[c].ToOutput(sensors[c].Expose(seen, cam.exposure_ms, noise_frame));
     return last_written[c];
