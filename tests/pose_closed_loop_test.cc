@@ -92,67 +92,83 @@ fs::path* PoseClosedLoopTest::dir_ = nullptr;
 fs::path* PoseClosedLoopTest::seq_ = nullptr;
 std::vector<nlohmann::json>* PoseClosedLoopTest::truth_ = nullptr;
 
+// The filter is random (seeded): one seed is one sample of its accuracy, and
+// a single unlucky seed can lose an arm for a few frames. The errors are
+// pooled over three seeds of the filter on the same frames.
 TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   const SequenceInput input = SequenceInput::Open(*seq_);
   const FrontEnd front_end = FrontEnd::Train(input, {});
-  PoseTracker tracker(input.cameras(), input.screens(), {});
   std::map<std::string, std::vector<double>> errors;
   std::vector<double> pointing_deg;
-  int first_tracking = -1;
   const int inside = FullyInside();
   ASSERT_GT(inside, 0) << "the person should walk in from outside the views";
+  // Three filters, one per seed, step through the same features.
+  const std::vector<uint64_t> seeds = {1, 2, 3};
+  std::vector<PoseTracker> trackers;
+  for (uint64_t seed : seeds) {
+    PoseTrackerOptions options;
+    options.seed = seed;
+    trackers.emplace_back(input.cameras(), input.screens(), options);
+  }
+  std::vector<int> first_tracking(seeds.size(), -1);
   for (int f = 0; f < input.frame_count(); ++f) {
     std::vector<cv::Mat> images;
     for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
-    const PoseEstimate e = tracker.Step(front_end.Process(f, images), 1.0 / input.fps());
-    const nlohmann::json& t = (*truth_)[f];
-    if (!t["present"].get<bool>()) continue;
-    // Tracking has started once the tracker says so and the root is right.
-    if (first_tracking < 0 && e.tracking && RootError(e, t) < 0.10) first_tracking = f;
-    if (f < inside + 10 || !e.tracking) continue;
-    for (const char* name : {"root", "waist", "neck", "left_shoulder", "right_shoulder"}) {
-      errors[name].push_back((e.body.joints[ModelIndex(name)] - V(t["joints3d"][name])).norm());
-    }
-    for (const char* side : {"left", "right"}) {
-      if (t["labels"]["rest"][side].get<bool>()) continue;  // thesis 6.6 scores moving arms
-      for (const char* j : {"elbow", "wrist"}) {
-        const std::string name = std::string(side) + "_" + j;
+    const FrameFeatures features = front_end.Process(f, images);
+    for (size_t s = 0; s < seeds.size(); ++s) {
+      const PoseEstimate e = trackers[s].Step(features, 1.0 / input.fps());
+      const nlohmann::json& t = (*truth_)[f];
+      if (!t["present"].get<bool>()) continue;
+      // Tracking has started once the tracker says so and the root is right.
+      if (first_tracking[s] < 0 && e.tracking && RootError(e, t) < 0.10) first_tracking[s] = f;
+      if (f < inside + 10 || !e.tracking) continue;
+      for (const char* name : {"root", "waist", "neck", "left_shoulder", "right_shoulder"}) {
         errors[name].push_back((e.body.joints[ModelIndex(name)] - V(t["joints3d"][name])).norm());
       }
-      const nlohmann::json& ray = t["pointing"][side];
-      const auto& tracked = e.pointing[std::string(side) == "right" ? 0 : 1];
-      if (!ray.is_null() && tracked) {
-        pointing_deg.push_back(std::acos(std::clamp(tracked->dir.dot(V(ray["dir"]).normalized()), -1.0, 1.0)) * 180 /
-                               M_PI);
+      for (const char* side : {"left", "right"}) {
+        if (t["labels"]["rest"][side].get<bool>()) continue;  // thesis 6.6 scores moving arms
+        for (const char* j : {"elbow", "wrist"}) {
+          const std::string name = std::string(side) + "_" + j;
+          errors[name].push_back((e.body.joints[ModelIndex(name)] - V(t["joints3d"][name])).norm());
+        }
+        const nlohmann::json& ray = t["pointing"][side];
+        const auto& tracked = e.pointing[std::string(side) == "right" ? 0 : 1];
+        if (!ray.is_null() && tracked) {
+          pointing_deg.push_back(std::acos(std::clamp(tracked->dir.dot(V(ray["dir"]).normalized()), -1.0, 1.0)) *
+                                 180 / M_PI);
+        }
       }
     }
   }
-  ASSERT_GE(first_tracking, 0);
-  std::printf("fully inside at frame %d, tracking (root within 10 cm) from frame %d\n", inside, first_tracking);
-  // Issue 7's bar is 10 frames; measured 18 here (see the issue note): this
-  // guards against regressions.
-  EXPECT_LE(first_tracking, inside + 25) << "fully inside at " << inside;
+  for (size_t s = 0; s < seeds.size(); ++s) {
+    ASSERT_GE(first_tracking[s], 0) << "seed " << seeds[s];
+    std::printf("seed %d: fully inside at frame %d, tracking (root within 10 cm) from frame %d\n",
+                static_cast<int>(seeds[s]), inside, first_tracking[s]);
+    // Issue 7's bar is 10 frames; measured 6-19 here over seeds 1-8 (see
+    // the issue note): this guards against regressions.
+    EXPECT_LE(first_tracking[s], inside + 25) << "seed " << seeds[s] << ", fully inside at " << inside;
+  }
   for (const auto& [name, e] : errors) {
     RecordProperty(name + "_mean_cm", std::to_string(Mean(e) * 100));
     std::printf("%-16s mean %5.2f cm over %zu frames\n", name.c_str(), Mean(e) * 100, e.size());
   }
   std::printf("pointing         mean %5.2f deg over %zu frames\n", Mean(pointing_deg), pointing_deg.size());
   // Issue 7's bars are 5 cm for shoulders, elbows and wrists, 4 cm for waist
-  // and neck, 5 cm for the root, 3 deg pointing. Measured here (seeded, so
-  // the same on every run): arms 2.9-5.9 cm, waist 5.0, neck 4.0, root 4.4,
-  // pointing 4.5 deg (2.1-3.9 deg over the demo session for four of the five
-  // persons; this case is short). The thresholds guard that with a margin; the bars not
-  // yet met are named in the issue note.
+  // and neck, 5 cm for the root, 3 deg pointing. Measured on these frames
+  // over tracker seeds 1-8 (the issue note): arms 3.2-6.9 cm per seed (means
+  // 4.0-5.4), waist 4.7, neck 3.2, root 4.8, pointing 2.4 deg. The
+  // thresholds guard that with a margin; the bars not yet met are named in
+  // the issue note.
   for (const char* arm : {"left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist",
                           "right_wrist"}) {
-    if (errors[arm].size() < 10) continue;  // an arm that never moved
-    EXPECT_LT(Mean(errors[arm]), 0.08) << arm;
+    if (errors[arm].size() < 30) continue;  // an arm that never moved
+    EXPECT_LT(Mean(errors[arm]), 0.075) << arm;
   }
   EXPECT_LT(Mean(errors["waist"]), 0.06);
-  EXPECT_LT(Mean(errors["neck"]), 0.06);
+  EXPECT_LT(Mean(errors["neck"]), 0.055);
   EXPECT_LT(Mean(errors["root"]), 0.065);
-  ASSERT_GT(pointing_deg.size(), 10u);
-  EXPECT_LT(Mean(pointing_deg), 5.5);
+  ASSERT_GT(pointing_deg.size(), 30u);
+  EXPECT_LT(Mean(pointing_deg), 4.0);
 }
 
 // Thesis 6.6 reports recovery in 2-3 frames after a loss: scatter the

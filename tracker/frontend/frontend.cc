@@ -1,6 +1,7 @@
 #include "tracker/frontend/frontend.h"
 
 #include <chrono>
+#include <stdexcept>
 
 #include "common/error.h"
 
@@ -13,6 +14,9 @@ void FrontEndOptions::Check() const {
   polygons.Check();
   voxels.Check();
   polyhedral.Check();
+  if (!(placement_max_coverage > 0 && placement_max_coverage <= 1)) {
+    throw std::invalid_argument("front end placement_max_coverage: must be in (0, 1]");
+  }
 }
 
 std::optional<BodyPlacement> PlaceBody(const VoxelHull& hull, double legs_height_m, double min_volume_m3) {
@@ -75,6 +79,38 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
   return fe;
 }
 
+std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, const std::vector<cv::Mat>& silhouettes,
+                                                     double max_coverage) {
+  std::optional<BodyPlacement> best;
+  for (size_t c = 0; c < silhouettes.size(); ++c) {
+    if (cv::countNonZero(silhouettes[c]) == 0) continue;  // nothing there: an empty stage, not a lost body
+    std::vector<cv::Mat> others = silhouettes;
+    others[c] = cv::Mat(silhouettes[c].size(), CV_8U, cv::Scalar(255));  // camera c places no constraint
+    const VoxelHull hull = carver.Carve(others);
+    std::optional<BodyPlacement> p = PlaceBody(hull);
+    if (!p) continue;
+    // The share of the others' hull (voxel centres) camera c's silhouette covers.
+    const Camera& cam = carver.cameras()[c];
+    int seen = 0, inside = 0;
+    for (const Eigen::Vector3d& v : hull.OccupiedCenters()) {
+      if ((cam.cam_from_world * v).z() <= 0.05) continue;
+      const Eigen::Vector2d px = cam.Project(v);
+      const int u = static_cast<int>(std::lround(px.x())), w = static_cast<int>(std::lround(px.y()));
+      if (u < 0 || w < 0 || u >= silhouettes[c].cols || w >= silhouettes[c].rows) continue;
+      ++seen;
+      inside += silhouettes[c].at<uint8_t>(w, u) > 127;
+    }
+    if (seen == 0) continue;
+    p->dropped_view = static_cast<int>(c);
+    p->dropped_view_coverage = static_cast<double>(inside) / seen;
+    if (p->dropped_view_coverage < max_coverage &&
+        (!best || p->dropped_view_coverage < best->dropped_view_coverage)) {
+      best = p;
+    }
+  }
+  return best;
+}
+
 FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) const {
   const auto start = std::chrono::steady_clock::now();
   FrameFeatures out;
@@ -109,6 +145,10 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
     t = std::chrono::steady_clock::now();
     out.voxels = carver_->Carve(silhouettes);
     out.placement = PlaceBody(*out.voxels);
+    if (!out.placement && options_.placement_drop_view && silhouettes.size() >= 4 &&
+        options_.voxels.max_missing_views == 0) {
+      out.placement = PlaceBodyWithoutOneView(*carver_, silhouettes, options_.placement_max_coverage);
+    }
     out.ms_voxels = since(t);
   }
   if (options_.polyhedral_hull) {

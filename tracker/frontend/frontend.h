@@ -29,6 +29,16 @@ struct FrontEndOptions {
   PolygonOptions polygons;  // silhouette outlines, 20-30 edges (thesis 3.1, 4.1)
   VoxelGridOptions voxels;  // voxel hull (thesis 4.2)
   bool carve_voxels = true;
+  // When the hull of all views holds no person, place the body from the
+  // hull of all views but one: the camera whose silhouette covers least of
+  // what the other cameras' hull projects into it, when that share is below
+  // `placement_max_coverage` (a view that lost most of the body: an
+  // overhead camera over a floor as grey as the clothing, under heavy
+  // noise). With 4 or more cameras only; the voxels stay the full hull.
+  // On theater4 a view that lost the legs covers 0.24-0.35 of the others'
+  // hull, an intact one 0.59 or more (frontend_closed_loop_test).
+  bool placement_drop_view = true;
+  double placement_max_coverage = 0.5;
   PolyhedralHullOptions polyhedral;  // polyhedral hull (thesis 4.1)
   // Built on request (irbench track --ply): nothing downstream uses it yet and
   // it is the front end's most expensive stage.
@@ -52,9 +62,23 @@ struct BodyPlacement {
   Eigen::Vector3d root = Eigen::Vector3d::Zero();  // z = 0
   double top_m = 0;
   double volume_m3 = 0;
+  // -1: from the hull of all views; else the camera left out
+  // (FrontEndOptions::placement_drop_view) and the share of the other views'
+  // hull its silhouette covered.
+  int dropped_view = -1;
+  double dropped_view_coverage = 1;
 };
 std::optional<BodyPlacement> PlaceBody(const VoxelHull& hull, double legs_height_m = 0.5,
                                        double min_volume_m3 = 0.02);
+
+// The placement from the hull of all cameras but one, for when one camera's
+// silhouette lost the body (PlaceBody of the full hull found none): for each
+// camera c with any silhouette, the hull of the others (c's image taken as
+// all silhouette) and the share of that hull's voxel centres c's silhouette
+// covers; the camera covering least, when below `max_coverage`. nullopt when
+// no camera qualifies.
+std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, const std::vector<cv::Mat>& silhouettes,
+                                                     double max_coverage);
 
 struct FrameFeatures {
   int frame = 0;

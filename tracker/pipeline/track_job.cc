@@ -226,6 +226,15 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                         {"volume_m3", std::round(features.voxels->VolumeM3() * 1e5) / 1e5},
                         {"voxel_size_m", features.voxels->voxel_size_m}};
     }
+    line["placement"] =
+        features.placement
+            ? nlohmann::json{{"root", Rounded(features.placement->root)},
+                             {"top_m", std::round(features.placement->top_m * 1e3) / 1e3},
+                             {"dropped_view", features.placement->dropped_view < 0
+                                                  ? nlohmann::json(nullptr)
+                                                  : nlohmann::json(input.cameras()[features.placement->dropped_view].name)},
+                             {"dropped_view_coverage", std::round(features.placement->dropped_view_coverage * 1e3) / 1e3}}
+            : nlohmann::json(nullptr);
     line["polyhedral_hull"] =
         features.hull ? nlohmann::json{{"vertices", features.hull->vertices.size()},
                                        {"triangles", features.hull->triangles.size()},

@@ -233,7 +233,14 @@ BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& f
   const auto by_side = ArmPointsBySide(arm_chains_.points, arm_chains_.chain, arm_chains_.count,
                                        body.frames[kRightUpperArm].translation(),
                                        body.frames[kLeftUpperArm].translation());
+  // Half the proposals set both arms, the rest one arm (either side alike):
+  // the other arm keeps its pose, so that a raised arm the axis points miss
+  // this frame is not forced down while the seen one is placed.
+  std::uniform_int_distribution<int> which(0, 3);
+  const int only = which(rng_);  // 0, 1: both arms; 2: right only; 3: left only
+  std::uniform_real_distribution<double> coin(0.0, 1.0);
   for (int arm : {kRightUpperArm, kLeftUpperArm}) {
+    if ((only == 2 && arm != kRightUpperArm) || (only == 3 && arm != kLeftUpperArm)) continue;
     const Vector3d shoulder = body.frames[arm].translation();
     const std::vector<Vector3d>& points = by_side[arm == kRightUpperArm ? 0 : 1];
     std::vector<Vector3d> upper_points;
@@ -249,7 +256,10 @@ BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& f
     }
     Vector3d upper, fore;
     if (!farthest) {
-      // No arm seen apart from the body: most likely hanging at rest.
+      // No arm seen apart from the body: most likely hanging at rest, but
+      // an arm in front of the torso in every view is not seen either, so
+      // half the time the arm keeps its pose.
+      if (coin(rng_) < 0.5) continue;
       const Eigen::Matrix3d world_from_upper = body.frames[kUpperBody].linear();
       const double side = arm == kRightUpperArm ? 1.0 : -1.0;
       upper = fore = (world_from_upper * Vector3d(0.15 * side, 0.0, -1.0)).normalized();
