@@ -38,6 +38,7 @@ void PoseTrackerOptions::Check() const {
     if (!(p >= 0)) throw std::invalid_argument("pose proposal probabilities must be non-negative");
   }
   if (!(p_flip >= 0 && p_flip <= 1)) throw std::invalid_argument("pose.p_flip must be in [0, 1]");
+  if (!(p_turn >= 0 && p_flip + p_turn <= 1)) throw std::invalid_argument("pose.p_turn must be in [0, 1 - p_flip]");
   if (!(p_random_walk + p_body_position + p_arm_direction + p_default_pose > 0)) {
     throw std::invalid_argument("pose proposal probabilities must not all be zero");
   }
@@ -302,6 +303,25 @@ BodyPose PoseTracker::DefaultPoseProposal(const BodyPose& current, const FrameFe
   return p;
 }
 
+BodyPose PoseTracker::TurnedPose(const BodyPose& current, double yaw) const {
+  const PosedBody body = PoseBody(shape_, current);
+  BodyPose next = current;
+  next.dof[kDofYaw] = yaw;
+  next.dof[kDofWaistZ] = 0;
+  PlaceRoot(shape_, &next, body.joints[kModelRoot].head<2>());
+  const struct {
+    int segment, shoulder, elbow, wrist;
+  } arms[] = {{kRightUpperArm, kModelRightShoulder, kModelRightElbow, kModelRightWrist},
+              {kLeftUpperArm, kModelLeftShoulder, kModelLeftElbow, kModelLeftWrist}};
+  for (const auto& a : arms) {
+    const Vector3d upper = body.joints[a.elbow] - body.joints[a.shoulder];
+    const Vector3d fore = body.joints[a.wrist] - body.joints[a.elbow];
+    if (upper.norm() < 1e-6 || fore.norm() < 1e-6) continue;
+    SetArmDirections(shape_, &next, a.segment, upper.normalized(), fore.normalized());
+  }
+  return next;
+}
+
 BodyPose FlippedPose(const BodyPose& pose) {
   BodyPose f = pose;
   auto& q = f.dof;
@@ -334,7 +354,14 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
   std::normal_distribution<double> n01(0.0, 1.0);
   const double k = std::sqrt(std::max(dt, 1e-3) * 30.0);
   BodyPose next = current;
-  if (u(rng_) < options_.p_flip * total) {
+  const double flip_or_turn = u(rng_);
+  if (flip_or_turn < options_.p_turn * total && !walking_ && !entering_) {
+    // Turned (see PoseTrackerOptions::p_turn); not while walking or entering,
+    // where the heading is the walk's.
+    const double yaw = u(rng_) < 0.5 * total ? YawFacing(facing_xy_) + 0.15 * n01(rng_)
+                                             : current.dof[kDofYaw] + 0.8 * n01(rng_);
+    next = TurnedPose(current, yaw);
+  } else if (flip_or_turn < (options_.p_turn + options_.p_flip) * total) {
     // Front/back flip (silhouettes barely tell them apart): turned half way
     // round with the arms swapped so the silhouettes stay nearly the same;
     // the heading priors and raised arms' joint limits decide.

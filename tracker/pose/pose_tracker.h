@@ -41,6 +41,12 @@ struct PoseTrackerOptions {
   // Share of particles turned half way round with their arms swapped
   // (FlippedPose), tried before the proposals above.
   double p_flip = 0.03;
+  // Share of particles turned to another heading with their arms kept
+  // pointing where they point (TurnedPose): half face the screen, half turn
+  // by a random angle. A body stuck side-on after a walk turns back this way;
+  // the random walk's yaw steps are too small to leave that optimum. Not
+  // while the user walks or enters (the walk gives the heading then).
+  double p_turn = 0.04;
   // Random-walk noise per frame at 30 fps (scaled by sqrt(dt * 30)).
   double sigma_position_m = 0.02;
   double sigma_yaw_rad = 0.06;
@@ -130,6 +136,7 @@ class PoseTracker {
   BodyPose Propose(const BodyPose& current, const BodyPose& previous, const FrameFeatures& features, double dt);
   BodyPose ArmDirectionProposal(BodyPose pose, const FrameFeatures& features);
   BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
+  BodyPose TurnedPose(const BodyPose& current, double yaw) const;
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
   double HeadingPrior(const BodyPose& pose) const;
   bool InView(const Eigen::Vector3d& root) const;
