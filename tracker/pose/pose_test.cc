@@ -336,8 +336,8 @@ int FlippedFramesAfterAWalk(double walk_memory_s, uint64_t seed = 7) {
   return flipped;
 }
 
-// Over filter seeds 1-12, at most one frame in 96 flips (seed 7); a single
-// seed is one sample, so the test takes six.
+// Over filter seeds 1-12, at most one frame in 96 flips (seeds 2 and 12);
+// a single seed is one sample, so the test takes six.
 TEST(PoseTracker, KeepsFacingWhereItWalkedUntilItTurns) {
   int total = 0;
   for (uint64_t seed = 5; seed <= 10; ++seed) {
