@@ -105,11 +105,15 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   // Three filters, one per seed, step through the same features.
   const std::vector<uint64_t> seeds = {1, 2, 3};
   std::vector<PoseTracker> trackers;
+  // The shipped rest-state SVM (thesis 6.4), trained on other motions' truth.
+  const auto rest = std::make_shared<const RestClassifier>(RestClassifier::Load(DefaultRestModelPath()));
   for (uint64_t seed : seeds) {
     PoseTrackerOptions options;
     options.seed = seed;
     trackers.emplace_back(input.cameras(), input.screens(), options);
+    trackers.back().set_rest_classifier(rest);
   }
+  int rest_correct = 0, rest_total = 0;
   std::vector<int> first_tracking(seeds.size(), -1);
   for (int f = 0; f < input.frame_count(); ++f) {
     std::vector<cv::Mat> images;
@@ -126,6 +130,11 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
         errors[name].push_back((e.body.joints[ModelIndex(name)] - V(t["joints3d"][name])).norm());
       }
       for (const char* side : {"left", "right"}) {
+        const auto& rest_decision = e.rest[std::string(side) == "right" ? 0 : 1];
+        if (rest_decision) {
+          rest_correct += *rest_decision == t["labels"]["rest"][side].get<bool>();
+          ++rest_total;
+        }
         if (t["labels"]["rest"][side].get<bool>()) continue;  // thesis 6.6 scores moving arms
         for (const char* j : {"elbow", "wrist"}) {
           const std::string name = std::string(side) + "_" + j;
@@ -153,9 +162,12 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
     std::printf("%-16s mean %5.2f cm over %zu frames\n", name.c_str(), Mean(e) * 100, e.size());
   }
   std::printf("pointing         mean %5.2f deg over %zu frames\n", Mean(pointing_deg), pointing_deg.size());
+  const double rest_accuracy = rest_total ? static_cast<double>(rest_correct) / rest_total : 0.0;
+  RecordProperty("rest_accuracy", std::to_string(rest_accuracy));
+  std::printf("rest state       %5.1f %% of %d arm-frames\n", 100 * rest_accuracy, rest_total);
   // Issue 7's bars are 5 cm for shoulders, elbows and wrists, 4 cm for waist
   // and neck, 5 cm for the root, 3 deg pointing. Measured on these frames,
-  // seeds 1-3 pooled (the issue note): arm joints 3.4-5.0 cm, waist 5.1,
+  // seeds 1-3 pooled (the issue note): arm joints 3.4-5.3 cm, waist 5.1,
   // neck 3.1, root 5.6, pointing 2.3 deg (a variant that also turned
   // particles while walking: arms 2.7-4.5, waist 4.6, root 4.8 - small
   // changes move these by about half a centimetre either way). The
@@ -171,6 +183,10 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   EXPECT_LT(Mean(errors["root"]), 0.065);
   ASSERT_GT(pointing_deg.size(), 30u);
   EXPECT_LT(Mean(pointing_deg), 4.0);
+  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.3 % (the
+  // SVM alone, without the likelihood-ratio test: 90.8 %).
+  EXPECT_GT(rest_total, 1000);
+  EXPECT_GT(rest_accuracy, 0.95);
 }
 
 // Thesis 6.6 reports recovery in 2-3 frames after a loss: scatter the

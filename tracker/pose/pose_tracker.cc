@@ -52,6 +52,8 @@ void PoseTrackerOptions::Check() const {
     throw std::invalid_argument("pose.refine_fraction must be in [0, 1]");
   }
   if (!(min_overlap >= 0 && min_overlap <= 1)) throw std::invalid_argument("pose.min_overlap must be in [0, 1]");
+  if (!(rest_max_log_overlap_loss >= 0)) throw std::invalid_argument("pose.rest_max_log_overlap_loss must be non-negative");
+  if (rest_min_frames < 1) throw std::invalid_argument("pose.rest_min_frames must be at least 1");
   if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
   if (!(walk_memory_s >= 0)) throw std::invalid_argument("pose.walk_memory_s must be non-negative");
 }
@@ -434,6 +436,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   if (!features.placement || features.cameras.size() != cameras_.size()) {
     active_ = false;
     lost_ = false;
+    rest_test_run_[0] = rest_test_run_[1] = 0;
     out.ms_total = Millis(start);
     return out;
   }
@@ -607,6 +610,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   }
   out.shape = shape_;
   out.body = PoseBody(shape_, out.pose);
+  if (!out.tracking) rest_test_run_[0] = rest_test_run_[1] = 0;
   if (out.tracking && rest_ && !rest_->empty()) {
     // Thesis 6.4: an arm at rest is forced down. The decision is a vote of
     // the particles, weighted by their likelihood tempered tenfold: an arm
@@ -631,17 +635,25 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
         rest_weight += r ? vote_weight[i] : 0.0;
         total_weight += vote_weight[i];
       }
-      const bool at_rest = rest_weight > 0.5 * total_weight;
-      out.rest[side] = at_rest;
-      if (at_rest) {
-        const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
-        const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
-        out.pose.dof[sh] = 0.0;
-        out.pose.dof[sh + 1] = 0.1;
-        out.pose.dof[sh + 2] = 0.0;
-        out.pose.dof[el] = 0.0;
-        out.pose.dof[el + 1] = 0.0;
+      const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
+      const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
+      BodyPose down = out.pose;
+      down.dof[sh] = 0.0;
+      down.dof[sh + 1] = 0.1;
+      down.dof[sh + 2] = 0.0;
+      down.dof[el] = 0.0;
+      down.dof[el + 1] = 0.0;
+      bool at_rest = rest_weight > 0.5 * total_weight;
+      if (options_.rest_max_log_overlap_loss > 0) {
+        // The likelihood-ratio test (PoseTrackerOptions::rest_max_log_overlap_loss)
+        // against the estimate as it stands (the other arm perhaps forced down).
+        const double loss =
+            (Evaluate(out.pose, views, nullptr) - Evaluate(down, views, nullptr)) / options_.observation.sharpness;
+        rest_test_run_[side] = loss < options_.rest_max_log_overlap_loss ? rest_test_run_[side] + 1 : 0;
+        at_rest = at_rest || rest_test_run_[side] >= options_.rest_min_frames;
       }
+      out.rest[side] = at_rest;
+      if (at_rest) out.pose = down;
     }
     out.body = PoseBody(shape_, out.pose);
   }

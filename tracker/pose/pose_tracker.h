@@ -74,6 +74,17 @@ struct PoseTrackerOptions {
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
+  // Rest state (thesis 6.4): besides the SVM's vote, an arm is at rest when
+  // forcing it down (the pose the estimate then shows) costs the best
+  // particle less than this in the sum over cameras of log overlap ratio:
+  // the silhouettes cannot tell that arm from a hanging one ("when the arms
+  // ... are wrapped near the body, the silhouettes are visually nearly
+  // undistinguishable"). The SVM, trained on exact joints, takes a hanging
+  // arm the filter has put at the torso's side or behind it for a raised
+  // one. It must hold this many frames in a row (a moving arm passes it for
+  // a frame now and then). 0 turns the test off.
+  double rest_max_log_overlap_loss = 0.27;
+  int rest_min_frames = 2;
   // Tracking is declared when the voxel hull sees a person and the best
   // particle's mean overlap ratio reaches this.
   double min_overlap = 0.35;
@@ -178,6 +189,9 @@ class PoseTracker {
   // stage's centre (walk_dir_), as they face a walk's direction.
   bool entering_ = false;
   bool lost_ = false;
+  // Per arm (right, left): frames in a row that forcing it down cost less
+  // than rest_max_log_overlap_loss.
+  int rest_test_run_[2] = {0, 0};
 };
 
 }  // namespace irbench
