@@ -53,6 +53,7 @@ void PoseTrackerOptions::Check() const {
   }
   if (!(min_overlap >= 0 && min_overlap <= 1)) throw std::invalid_argument("pose.min_overlap must be in [0, 1]");
   if (!(rest_max_log_overlap_loss >= 0)) throw std::invalid_argument("pose.rest_max_log_overlap_loss must be non-negative");
+  if (!(max_rise_m >= 0)) throw std::invalid_argument("pose.max_rise_m must be non-negative");
   if (rest_min_frames < 1) throw std::invalid_argument("pose.rest_min_frames must be at least 1");
   if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
   if (!(walk_memory_s >= 0)) throw std::invalid_argument("pose.walk_memory_s must be non-negative");
@@ -427,6 +428,7 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
+  next.dof[kDofZ] = std::min(next.dof[kDofZ], shape_.waist_height_m + options_.max_rise_m);
   return next;
 }
 
@@ -548,6 +550,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
       for (int j = r.start; j < r.end; ++j) {
         refined[j] = RefineIcp(shape_, proposed[order[j]], icp_views, options_.icp);
+        refined[j].dof[kDofZ] = std::min(refined[j].dof[kDofZ], shape_.waist_height_m + options_.max_rise_m);
         refined_ll[j] = Evaluate(refined[j], views, nullptr) + HeadingPrior(refined[j]);
       }
     });

@@ -71,6 +71,11 @@ struct PoseTrackerOptions {
   // walking direction to the screen's (linearly). A user first seen half in
   // view is entering, heading for the stage's centre: the same memory.
   double walk_memory_s = 2.0;
+  // The waist rises at most this far above its standing height (the shape's
+  // waist_height_m): the feet stay on the floor. Left free, the filter
+  // lifted tall bodies 3-5 cm to fit their silhouettes, raising the head
+  // that pointing rays start from. Crouching and bowing lower it freely.
+  double max_rise_m = 0.02;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
