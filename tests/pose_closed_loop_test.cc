@@ -153,8 +153,11 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
     ASSERT_GE(first_tracking[s], 0) << "seed " << seeds[s];
     std::printf("seed %d: fully inside at frame %d, tracking (root within 10 cm) from frame %d\n",
                 static_cast<int>(seeds[s]), inside, first_tracking[s]);
-    // Issue 7's bar is 10 frames; measured 6-18 here (seeds 1-3: 6, 6 and
-    // 18 frames after fully inside): this guards against regressions.
+    // Issue 7's bar is 10 frames; measured 6-17 here (seeds 1-3: 17, 6 and
+    // 6 frames after fully inside): this guards against regressions. The
+    // truth's root is the floor point under the ankles, the tracker's under
+    // the waist: mid-stride they lie 10-15 cm apart, so a user still
+    // walking in reads as off target.
     EXPECT_LE(first_tracking[s], inside + 25) << "seed " << seeds[s] << ", fully inside at " << inside;
   }
   for (const auto& [name, e] : errors) {
@@ -167,10 +170,10 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   std::printf("rest state       %5.1f %% of %d arm-frames\n", 100 * rest_accuracy, rest_total);
   // Issue 7's bars are 5 cm for shoulders, elbows and wrists, 4 cm for waist
   // and neck, 5 cm for the root, 3 deg pointing. Measured on these frames,
-  // seeds 1-3 pooled (the issue note): arm joints 3.4-5.3 cm, waist 5.1,
-  // neck 3.1, root 5.6, pointing 2.3 deg (a variant that also turned
-  // particles while walking: arms 2.7-4.5, waist 4.6, root 4.8 - small
-  // changes move these by about half a centimetre either way). The
+  // seeds 1-3 pooled (the issue note), with the rest-state SVM and the
+  // waist cap: arm joints 3.1-5.0 cm, waist 4.3, neck 3.0, root 4.7,
+  // pointing 2.5 deg (small changes move these by about half a centimetre
+  // either way). The
   // thresholds guard that with a margin; the bars not yet met are named in
   // the issue note.
   for (const char* arm : {"left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist",
@@ -183,7 +186,7 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   EXPECT_LT(Mean(errors["root"]), 0.065);
   ASSERT_GT(pointing_deg.size(), 30u);
   EXPECT_LT(Mean(pointing_deg), 4.0);
-  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.3 % (the
+  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.6 % (the
   // SVM alone, without the likelihood-ratio test: 90.8 %).
   EXPECT_GT(rest_total, 1000);
   EXPECT_GT(rest_accuracy, 0.95);
