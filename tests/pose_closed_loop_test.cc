@@ -156,7 +156,7 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
     // Issue 7's bar is 10 frames; measured 6-17 here (seeds 1-3: 17, 6 and
     // 6 frames after fully inside): this guards against regressions. The
     // truth's root is the floor point under the ankles, the tracker's under
-    // the waist: mid-stride they lie 10-15 cm apart, so a user still
+    // the waist: while walking they lie about 10 cm apart, so a user still
     // walking in reads as off target.
     EXPECT_LE(first_tracking[s], inside + 25) << "seed " << seeds[s] << ", fully inside at " << inside;
   }
