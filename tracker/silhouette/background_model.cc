@@ -28,6 +28,10 @@ void BackgroundOptions::Check() const {
   if (!(min_blob_fraction >= 0 && min_blob_fraction < 1)) {
     throw std::invalid_argument("background min_blob_fraction: must be in [0, 1)");
   }
+  if (!(near_blob_px >= 0)) throw std::invalid_argument("background near_blob_px: must be non-negative");
+  if (!(near_blob_min_fraction >= 0 && near_blob_min_fraction < 1)) {
+    throw std::invalid_argument("background near_blob_min_fraction: must be in [0, 1)");
+  }
 }
 
 std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>& frames,
@@ -234,11 +238,13 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   const double scale = frame.cols / 320.0;
   r.blobs_removed = CleanMask(r.mask, static_cast<int>(std::lround(options_.open_radius * scale)),
                               static_cast<int>(std::lround(options_.close_radius * scale)),
-                              static_cast<int>(options_.min_blob_fraction * frame.total()));
+                              static_cast<int>(options_.min_blob_fraction * frame.total()),
+                              static_cast<int>(std::lround(options_.near_blob_px * scale)),
+                              static_cast<int>(options_.near_blob_min_fraction * frame.total()));
   return r;
 }
 
-int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area) {
+int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, int near_px, int near_min_area) {
   auto kernel = [](int r) {
     return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
   };
@@ -249,10 +255,29 @@ int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area) {
   const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   std::vector<uint8_t> keep(count, 0);
   int removed = 0;
-  for (int i = 1; i < count; ++i) {
-    keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_area;
-    removed += !keep[i];
+  for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_area;
+  if (near_px > 0) {
+    // Small blobs touching the kept blobs grown by near_px stay.
+    cv::Mat near(mask.size(), CV_8U, cv::Scalar(0));
+    for (int y = 0; y < mask.rows; ++y) {
+      const int* lp = labels.ptr<int>(y);
+      uint8_t* np = near.ptr<uint8_t>(y);
+      for (int x = 0; x < mask.cols; ++x) np[x] = keep[lp[x]] ? 255 : 0;
+    }
+    cv::dilate(near, near, kernel(near_px));
+    std::vector<uint8_t> rescued(count, 0);
+    for (int y = 0; y < mask.rows; ++y) {
+      const int* lp = labels.ptr<int>(y);
+      const uint8_t* np = near.ptr<uint8_t>(y);
+      for (int x = 0; x < mask.cols; ++x) {
+        if (np[x] && lp[x] > 0 && !keep[lp[x]] && stats.at<int>(lp[x], cv::CC_STAT_AREA) >= near_min_area) {
+          rescued[lp[x]] = 1;
+        }
+      }
+    }
+    for (int i = 1; i < count; ++i) keep[i] = keep[i] || rescued[i];
   }
+  for (int i = 1; i < count; ++i) removed += !keep[i];
   if (removed == 0) return 0;
   for (int y = 0; y < mask.rows; ++y) {
     const int* lp = labels.ptr<int>(y);

@@ -39,8 +39,14 @@ struct BackgroundOptions {
   double pool_sigma = 0.8;
   double pool_threshold = 6.0;
   double pool_weak_threshold = 3.0;  // hysteresis: weaker evidence joined to strong
-  // Connected blobs smaller than this fraction of the image are noise.
+  // Connected blobs smaller than this fraction of the image are noise,
+  // unless they lie within `near_blob_px` (at 320x240) of a blob kept by
+  // area and hold at least `near_blob_min_fraction`: a forearm or hand cut
+  // off from the body by a low-contrast gap (an upper arm seen end-on) is a
+  // part of the person, not a speck.
   double min_blob_fraction = 0.002;
+  double near_blob_px = 10;
+  double near_blob_min_fraction = 0.0003;
   // Throws std::invalid_argument naming the option.
   void Check() const;
 };
@@ -98,8 +104,10 @@ class BackgroundModel {
 };
 
 // Opening then closing with elliptical kernels of the given radii, then
-// removal of 8-connected blobs smaller than `min_area` pixels; returns the
-// number removed.
-int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area);
+// removal of 8-connected blobs smaller than `min_area` pixels, except those of
+// at least `near_min_area` pixels within `near_px` of a blob of `min_area` or
+// more (near_px 0: none kept); returns the number removed.
+int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, int near_px = 0,
+              int near_min_area = 0);
 
 }  // namespace irbench

@@ -147,6 +147,22 @@ TEST(BackgroundModelTest, CleanMaskRemovesSpecksAndSmallBlobs) {
   EXPECT_NEAR(cv::countNonZero(mask), 4800, 20);
 }
 
+// A forearm cut off from the body by a low-contrast gap is kept; the same
+// blob far from the body, and a speck near it, are not.
+TEST(BackgroundModelTest, CleanMaskKeepsASmallBlobNearTheBody) {
+  cv::Mat mask = cv::Mat::zeros(240, 320, CV_8U);
+  cv::rectangle(mask, cv::Rect(100, 50, 40, 120), 255, cv::FILLED);  // 4800 px body
+  cv::rectangle(mask, cv::Rect(147, 40, 6, 20), 255, cv::FILLED);    // 120 px forearm, 7 px off
+  cv::rectangle(mask, cv::Rect(250, 40, 6, 20), 255, cv::FILLED);    // the same, 110 px off
+  cv::rectangle(mask, cv::Rect(146, 120, 3, 3), 255, cv::FILLED);    // 9 px speck, 6 px off
+  cv::Mat plain = mask.clone();
+  EXPECT_EQ(CleanMask(plain, 0, 0, 150), 3);
+  EXPECT_EQ(cv::countNonZero(plain), 4800);
+  EXPECT_EQ(CleanMask(mask, 0, 0, 150, 10, 23), 2);
+  EXPECT_EQ(cv::countNonZero(mask), 4800 + 120);
+  EXPECT_EQ(cv::countNonZero(mask(cv::Rect(147, 40, 6, 20))), 120);
+}
+
 }  // namespace
 }  // namespace irbench
 
