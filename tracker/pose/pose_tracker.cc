@@ -514,6 +514,20 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     active_ = true;
     proposed = particles_;
   } else {
+    if (heights_.empty() && InView(features.placement->root)) {
+      // Until the height is measured (below), a model more than 10 % off the
+      // hull's top takes the top's height: a user first seen half in view
+      // can give a low top, and a model left that small explains the
+      // silhouettes too poorly to be tracked and measured (tracker seed 3 on
+      // p2's demo stayed 1.2 m tall for the whole session).
+      const double height = std::clamp(features.placement->top_m, 1.2, 2.2);
+      if (std::abs(height / shape_.height_m - 1) > 0.1) {
+        const double ratio = height / shape_.height_m;
+        shape_ = BodyShape::FromHeight(height, shape_.girth);
+        for (BodyPose& p : particles_) p.dof[kDofZ] *= ratio;
+        for (BodyPose& p : previous_) p.dof[kDofZ] *= ratio;
+      }
+    }
     for (size_t i = 0; i < particles_.size(); ++i) {
       proposed.push_back(Propose(particles_[i], previous_[i], features, dt));
     }
