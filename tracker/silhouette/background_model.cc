@@ -256,7 +256,11 @@ int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, in
   std::vector<uint8_t> keep(count, 0);
   int removed = 0;
   for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_area;
-  if (near_px > 0) {
+  bool candidates = false;  // a small blob large enough to be kept when near
+  for (int i = 1; i < count; ++i) {
+    candidates |= !keep[i] && stats.at<int>(i, cv::CC_STAT_AREA) >= near_min_area;
+  }
+  if (near_px > 0 && candidates) {
     // Small blobs touching the kept blobs grown by near_px stay.
     cv::Mat near(mask.size(), CV_8U, cv::Scalar(0));
     for (int y = 0; y < mask.rows; ++y) {
