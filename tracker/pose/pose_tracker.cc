@@ -348,6 +348,10 @@ BodyPose FlippedPose(const BodyPose& pose) {
   return f;
 }
 
+void PoseTracker::CapRise(BodyPose* pose) const {
+  pose->dof[kDofZ] = std::min(pose->dof[kDofZ], shape_.waist_height_m + options_.max_rise_m);
+}
+
 BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous, const FrameFeatures& features,
                               double dt) {
   const double total = options_.p_random_walk + options_.p_body_position + options_.p_arm_direction +
@@ -428,7 +432,7 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
-  next.dof[kDofZ] = std::min(next.dof[kDofZ], shape_.waist_height_m + options_.max_rise_m);
+  CapRise(&next);
   return next;
 }
 
@@ -564,7 +568,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
       for (int j = r.start; j < r.end; ++j) {
         refined[j] = RefineIcp(shape_, proposed[order[j]], icp_views, options_.icp);
-        refined[j].dof[kDofZ] = std::min(refined[j].dof[kDofZ], shape_.waist_height_m + options_.max_rise_m);
+        CapRise(&refined[j]);
         refined_ll[j] = Evaluate(refined[j], views, nullptr) + HeadingPrior(refined[j]);
       }
     });
@@ -639,6 +643,9 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
       vote_weight[i] = std::exp((log_likelihood[i] - log_likelihood[best]) / 10.0);
       if (vote_weight[i] >= 1e-3) voters[i] = PoseBody(shape_, proposed[i]);
     }
+    // The estimate's log-likelihood for the likelihood-ratio test, kept up
+    // to date when an arm is forced down.
+    double estimate_ll = options_.rest_max_log_overlap_loss > 0 ? Evaluate(out.pose, views, nullptr) : 0.0;
     for (int side = 0; side < 2; ++side) {
       const bool left = side == 1;
       double rest_weight = 0, total_weight = 0;
@@ -661,16 +668,20 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
       down.dof[el] = 0.0;
       down.dof[el + 1] = 0.0;
       bool at_rest = rest_weight > 0.5 * total_weight;
+      double down_ll = 0;
       if (options_.rest_max_log_overlap_loss > 0) {
         // The likelihood-ratio test (PoseTrackerOptions::rest_max_log_overlap_loss)
         // against the estimate as it stands (the other arm perhaps forced down).
-        const double loss =
-            (Evaluate(out.pose, views, nullptr) - Evaluate(down, views, nullptr)) / options_.observation.sharpness;
+        down_ll = Evaluate(down, views, nullptr);
+        const double loss = (estimate_ll - down_ll) / options_.observation.sharpness;
         rest_test_run_[side] = loss < options_.rest_max_log_overlap_loss ? rest_test_run_[side] + 1 : 0;
         at_rest = at_rest || rest_test_run_[side] >= options_.rest_min_frames;
       }
       out.rest[side] = at_rest;
-      if (at_rest) out.pose = down;
+      if (at_rest) {
+        out.pose = down;
+        estimate_ll = down_ll;
+      }
     }
     out.body = PoseBody(shape_, out.pose);
   }

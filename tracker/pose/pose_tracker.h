@@ -153,6 +153,8 @@ class PoseTracker {
   BodyPose ArmDirectionProposal(BodyPose pose, const FrameFeatures& features);
   BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
   BodyPose TurnedPose(const BodyPose& current, double yaw) const;
+  // The waist at most max_rise_m above its standing height.
+  void CapRise(BodyPose* pose) const;
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
   double HeadingPrior(const BodyPose& pose) const;
   bool InView(const Eigen::Vector3d& root) const;

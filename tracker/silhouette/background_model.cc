@@ -255,31 +255,30 @@ int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, in
   const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   std::vector<uint8_t> keep(count, 0);
   int removed = 0;
-  for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_area;
-  bool candidates = false;  // a small blob large enough to be kept when near
+  // Small blobs of near_min_area or more: kept when near a blob kept by area.
+  std::vector<uint8_t> candidate(count, 0);
   for (int i = 1; i < count; ++i) {
-    candidates |= !keep[i] && stats.at<int>(i, cv::CC_STAT_AREA) >= near_min_area;
+    const int area = stats.at<int>(i, cv::CC_STAT_AREA);
+    keep[i] = area >= min_area;
+    candidate[i] = near_px > 0 && !keep[i] && area >= near_min_area;
   }
-  if (near_px > 0 && candidates) {
-    // Small blobs touching the kept blobs grown by near_px stay.
-    cv::Mat near(mask.size(), CV_8U, cv::Scalar(0));
+  if (std::find(candidate.begin(), candidate.end(), 1) != candidate.end()) {
+    // Those touching the kept blobs grown by near_px stay (the grown mask is
+    // made before any is kept, so a kept one does not reach further).
+    cv::Mat near(mask.size(), CV_8U);
     for (int y = 0; y < mask.rows; ++y) {
       const int* lp = labels.ptr<int>(y);
       uint8_t* np = near.ptr<uint8_t>(y);
       for (int x = 0; x < mask.cols; ++x) np[x] = keep[lp[x]] ? 255 : 0;
     }
     cv::dilate(near, near, kernel(near_px));
-    std::vector<uint8_t> rescued(count, 0);
     for (int y = 0; y < mask.rows; ++y) {
       const int* lp = labels.ptr<int>(y);
       const uint8_t* np = near.ptr<uint8_t>(y);
       for (int x = 0; x < mask.cols; ++x) {
-        if (np[x] && lp[x] > 0 && !keep[lp[x]] && stats.at<int>(lp[x], cv::CC_STAT_AREA) >= near_min_area) {
-          rescued[lp[x]] = 1;
-        }
+        if (np[x] && candidate[lp[x]]) keep[lp[x]] = 1;
       }
     }
-    for (int i = 1; i < count; ++i) keep[i] = keep[i] || rescued[i];
   }
   for (int i = 1; i < count; ++i) removed += !keep[i];
   if (removed == 0) return 0;
