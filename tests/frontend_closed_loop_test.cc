@@ -297,6 +297,19 @@ TEST(FrontendClosedLoopTest, PlacementWithoutTheViewThatLostTheLegs) {
       const std::optional<BodyPlacement> p = PlaceBodyWithoutOneView(carver, broken, max_coverage);
       ASSERT_TRUE(p) << cam.name << ", frame " << f;
       EXPECT_EQ(p->dropped_view, static_cast<int>(lost)) << cam.name << ", frame " << f;
+      // From the caller's distance transforms: the same placement, and the
+      // transforms as they were (the view left out must not be written into).
+      std::vector<cv::Mat> distances, before;
+      for (const cv::Mat& m : broken) {
+        distances.push_back(DistanceToSilhouette(m));
+        before.push_back(distances.back().clone());
+      }
+      const std::optional<BodyPlacement> q = PlaceBodyWithoutOneView(carver, broken, max_coverage, &distances);
+      ASSERT_TRUE(q) << cam.name << ", frame " << f;
+      EXPECT_EQ(q->dropped_view, p->dropped_view);
+      EXPECT_EQ(q->root, p->root);
+      EXPECT_EQ(q->dropped_view_coverage, p->dropped_view_coverage);
+      for (size_t c = 0; c < distances.size(); ++c) EXPECT_EQ(cv::norm(distances[c], before[c], cv::NORM_INF), 0);
       // Without the side camera the legs' hull is longer in depth: 6 cm.
       EXPECT_LT((p->root - full->root).norm(), 0.08) << cam.name << ", frame " << f;
       std::printf("frame %d, %s without legs: placed from the others, coverage %.2f, root %.1f cm from the full hull's\n",

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -32,7 +33,11 @@ PreparedView Prepare(const AxisView& view, const Axis3dOptions& options) {
   out.cam_from_world_rotation = view.camera.cam_from_world.linear();
   out.cam_from_world_translation = view.camera.cam_from_world.translation();
   out.center_in_world = view.camera.CenterInWorld();
-  cv::distanceTransform(view.silhouette == 0, out.distance_to_silhouette, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  if (view.distance_to_silhouette.empty()) {
+    cv::distanceTransform(view.silhouette == 0, out.distance_to_silhouette, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  } else {
+    out.distance_to_silhouette = view.distance_to_silhouette;
+  }
   out.normalized.assign(view.graph.points.size(), Eigen::Vector2d::Constant(std::nan("")));
   for (size_t i = 0; i < view.labels.size(); ++i) {
     const auto slot = std::find(kImageParts.begin(), kImageParts.end(), view.labels[i]);
@@ -130,9 +135,16 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
       throw std::invalid_argument("ReconstructAxis3d: labels of camera '" + view.camera.name +
                                   "' do not match its axis graph");
     }
+    if (!view.distance_to_silhouette.empty() && (view.distance_to_silhouette.type() != CV_32FC1 ||
+                                                 view.distance_to_silhouette.size() != view.silhouette.size())) {
+      throw std::invalid_argument("ReconstructAxis3d: distance_to_silhouette of camera '" + view.camera.name +
+                                  "' is not CV_32FC1 of the camera's size");
+    }
   }
-  std::vector<PreparedView> prepared;
-  for (const AxisView& view : views) prepared.push_back(Prepare(view, options));
+  std::vector<PreparedView> prepared(views.size());
+  cv::parallel_for_(cv::Range(0, int(views.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) prepared[i] = Prepare(views[i], options);
+  });
 
   // Whether X projects onto (or near) every silhouette that sees it; counts them.
   auto support = [&](const Eigen::Vector3d& x) {
@@ -247,23 +259,37 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
 std::vector<AxisPoint3d> ReconstructBodyAxes(const std::vector<Camera>& cameras,
                                              const std::vector<cv::Mat>& silhouettes,
                                              const BodyAxesOptions& options,
-                                             std::vector<AxisView>* views_out) {
+                                             std::vector<AxisView>* views_out,
+                                             const std::vector<cv::Mat>* distances) {
   options.Check();
   if (cameras.size() != silhouettes.size()) {
     throw std::invalid_argument("ReconstructBodyAxes: one silhouette per camera");
   }
-  std::vector<AxisView> views(cameras.size());
+  if (distances && distances->size() != cameras.size()) {
+    throw std::invalid_argument("ReconstructBodyAxes: one distance transform per camera");
+  }
   for (size_t i = 0; i < cameras.size(); ++i) {
-    views[i].camera = cameras[i];
-    views[i].silhouette = silhouettes[i];
-    views[i].graph = ExtractAxisPoints(silhouettes[i], options.points);
-    const Eigen::Vector3d optical_axis_in_world = cameras[i].cam_from_world.linear().transpose().col(2);
-    const double elevation_deg = std::asin(std::clamp(optical_axis_in_world.z(), -1.0, 1.0)) / kDegToRad;
-    if (std::abs(elevation_deg) > options.max_view_elevation_deg) continue;
-    if (auto parts = SegmentBodyParts(silhouettes[i], views[i].graph, options.parts)) {
-      views[i].labels = std::move(parts->labels);
+    if (silhouettes[i].type() != CV_8UC1 || silhouettes[i].cols != cameras[i].width ||
+        silhouettes[i].rows != cameras[i].height) {
+      throw std::invalid_argument("ReconstructBodyAxes: silhouette of camera '" + cameras[i].name +
+                                  "' is not CV_8UC1 of the camera's size");
     }
   }
+  std::vector<AxisView> views(cameras.size());
+  cv::parallel_for_(cv::Range(0, int(cameras.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      views[i].camera = cameras[i];
+      views[i].silhouette = silhouettes[i];
+      if (distances) views[i].distance_to_silhouette = (*distances)[i];
+      views[i].graph = ExtractAxisPoints(silhouettes[i], options.points);
+      const Eigen::Vector3d optical_axis_in_world = cameras[i].cam_from_world.linear().transpose().col(2);
+      const double elevation_deg = std::asin(std::clamp(optical_axis_in_world.z(), -1.0, 1.0)) / kDegToRad;
+      if (std::abs(elevation_deg) > options.max_view_elevation_deg) continue;
+      if (auto parts = SegmentBodyParts(silhouettes[i], views[i].graph, options.parts)) {
+        views[i].labels = std::move(parts->labels);
+      }
+    }
+  });
   std::vector<AxisPoint3d> points = ReconstructAxis3d(views, options.axis3d);
   if (views_out) *views_out = std::move(views);
   return points;

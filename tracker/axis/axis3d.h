@@ -24,6 +24,10 @@ struct AxisView {
   // One per graph point; kNone for points the stage ignores. Empty: the view
   // only checks other views' 3D points against its silhouette.
   std::vector<BodyPart> labels;
+  // Optional, CV_32FC1 of the camera's size: each pixel's distance to the
+  // nearest silhouette pixel (as DistanceToSilhouette in tracker/hull), when
+  // the caller has it; computed from `silhouette` when empty.
+  cv::Mat distance_to_silhouette;
 };
 
 struct AxisPoint3d {
@@ -78,10 +82,13 @@ struct BodyAxesOptions {
 // The whole chain for one frame: 2D axis points (3.2), body parts (3.3) and 3D
 // axis points (4.4.2). `silhouettes[i]` is CV_8UC1 of `cameras[i]`'s size.
 // `views_out`, when given, receives each camera's 2D axis graph and part labels.
-// Throws std::invalid_argument for mismatched inputs.
+// `distances`, when given, holds each camera's AxisView::distance_to_silhouette.
+// The cameras' 2D stages run in parallel. Throws std::invalid_argument for
+// mismatched inputs.
 std::vector<AxisPoint3d> ReconstructBodyAxes(const std::vector<Camera>& cameras,
                                              const std::vector<cv::Mat>& silhouettes,
                                              const BodyAxesOptions& options = {},
-                                             std::vector<AxisView>* views_out = nullptr);
+                                             std::vector<AxisView>* views_out = nullptr,
+                                             const std::vector<cv::Mat>* distances = nullptr);
 
 }  // namespace irbench

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <array>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 namespace irbench {
@@ -35,6 +36,34 @@ struct ScanLines {
         return {std::max(0, k - (height - 1)), std::min(width - 1, k)};
     }
     return {0, -1};
+  }
+  // Inclusive t range of line k's pixels inside `box` (empty: first > second).
+  std::pair<int, int> RangeIn(int k, const cv::Rect& box) const {
+    auto [lo, hi] = Range(k);
+    const int x0 = box.x, x1 = box.x + box.width - 1, y0 = box.y, y1 = box.y + box.height - 1;
+    auto clip = [&](int a, int b) {
+      lo = std::max(lo, a);
+      hi = std::min(hi, b);
+    };
+    switch (direction) {
+      case ScanDirection::kHorizontal:
+        if (k < y0 || k > y1) return {0, -1};
+        clip(x0, x1);
+        break;
+      case ScanDirection::kVertical:
+        if (k < x0 || k > x1) return {0, -1};
+        clip(y0, y1);
+        break;
+      case ScanDirection::kDiagonalDown:
+        clip(y0, y1);
+        clip(x0 - k + height - 1, x1 - k + height - 1);
+        break;
+      case ScanDirection::kDiagonalUp:
+        clip(x0, x1);
+        clip(k - y1, k - y0);
+        break;
+    }
+    return {lo, hi};
   }
   cv::Point Pixel(int k, int t) const {
     switch (direction) {
@@ -88,13 +117,16 @@ AxisGraph ExtractAxisPoints(const cv::Mat& silhouette, const AxisPointOptions& o
   // Per direction and line: indices of its axis points in increasing t.
   std::array<std::vector<std::vector<int>>, kScanDirectionCount> by_line;
 
+  // Only the silhouette's box holds runs: each line is scanned across it.
+  const cv::Rect box = cv::boundingRect(silhouette);
   for (int d = 0; d < kScanDirectionCount; ++d) {
     const ScanLines lines{ScanDirection(d), w, h};
     const double step_len = lines.StepVector().norm();
     run_length[d] = cv::Mat1f(h, w, 0.0f);
     by_line[d].resize(lines.Count());
+    if (box.empty()) continue;
     for (int k = 0; k < lines.Count(); ++k) {
-      const auto [t_begin, t_end] = lines.Range(k);
+      const auto [t_begin, t_end] = lines.RangeIn(k, box);
       int t = t_begin;
       while (t <= t_end) {
         cv::Point p = lines.Pixel(k, t);

@@ -1,6 +1,8 @@
 #include "tracker/frontend/frontend.h"
 
 #include <chrono>
+#include <functional>
+#include <opencv2/core/utility.hpp>
 #include <stdexcept>
 
 #include "common/error.h"
@@ -80,13 +82,20 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
 }
 
 std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, const std::vector<cv::Mat>& silhouettes,
-                                                     double max_coverage) {
+                                                     double max_coverage, const std::vector<cv::Mat>* distances) {
+  std::vector<cv::Mat> own;
+  if (!distances) {
+    for (const cv::Mat& s : silhouettes) own.push_back(DistanceToSilhouette(s));
+    distances = &own;
+  }
   std::optional<BodyPlacement> best;
   for (size_t c = 0; c < silhouettes.size(); ++c) {
     if (cv::countNonZero(silhouettes[c]) == 0) continue;  // nothing there: an empty stage, not a lost body
-    std::vector<cv::Mat> others = silhouettes;
-    others[c] = cv::Mat(silhouettes[c].size(), CV_8U, cv::Scalar(255));  // camera c places no constraint
-    const VoxelHull hull = carver.Carve(others);
+    std::vector<cv::Mat> others = *distances;
+    // Camera c places no constraint: its image taken as all silhouette. (A
+    // new matrix: assigning Mat::zeros would write into the shared one.)
+    others[c] = cv::Mat(silhouettes[c].size(), CV_32F, cv::Scalar(0));
+    const VoxelHull hull = carver.CarveDistances(others);
     std::optional<BodyPlacement> p = PlaceBody(hull);
     if (!p) continue;
     // The share of the others' hull (voxel centres) camera c's silhouette covers.
@@ -112,42 +121,68 @@ std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, 
 }
 
 FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) const {
-  const auto start = std::chrono::steady_clock::now();
-  FrameFeatures out;
-  out.frame = frame;
-  for (size_t c = 0; c < background_.size(); ++c) {
-    const SilhouetteResult r = background_[c].Segment(frames.at(c));
-    CameraFeatures cf;
-    cf.before_shadows = r.mask;
-    cf.silhouette = options_.remove_shadows ? shadows_[c].Remove(frames[c], r.mask, r.darker) : r.mask;
-    cf.light_level = r.light_level;
-    cf.blobs_removed = r.blobs_removed;
-    out.cameras.push_back(std::move(cf));
+  const int nc = static_cast<int>(background_.size());
+  if (static_cast<int>(frames.size()) != nc) {
+    throw std::invalid_argument("front end: expected " + std::to_string(nc) + " frames, got " +
+                                std::to_string(frames.size()));
   }
-  const auto silhouettes_done = std::chrono::steady_clock::now();
-  out.ms_silhouettes = std::chrono::duration<double, std::milli>(silhouettes_done - start).count();
-  if (options_.find_axes) {
-    std::vector<cv::Mat> silhouettes;
-    for (const CameraFeatures& cf : out.cameras) silhouettes.push_back(cf.silhouette);
-    out.axis3d = ReconstructBodyAxes(cameras_, silhouettes, options_.axes, &out.views);
-    out.ms_axes =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - silhouettes_done).count();
+  for (int c = 0; c < nc; ++c) {
+    if (frames[c].type() != CV_8UC1 || frames[c].cols != cameras_[c].width || frames[c].rows != cameras_[c].height) {
+      throw std::invalid_argument("front end: the frame of camera '" + cameras_[c].name +
+                                  "' is not 8-bit grey of the camera's size");
+    }
   }
   auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
   };
+  // Per-camera work runs in parallel over the cameras (each camera's result
+  // is its own, so the output does not depend on the thread count).
+  auto per_camera = [nc](const std::function<void(int)>& f) {
+    cv::parallel_for_(cv::Range(0, nc), [&](const cv::Range& r) {
+      for (int c = r.start; c < r.end; ++c) f(c);
+    });
+  };
+  auto t = std::chrono::steady_clock::now();
+  FrameFeatures out;
+  out.frame = frame;
+  out.cameras.resize(nc);
+  per_camera([&](int c) {
+    const SilhouetteResult r = background_[c].Segment(frames[c]);
+    CameraFeatures& cf = out.cameras[c];
+    cf.before_shadows = r.mask;
+    cf.silhouette = options_.remove_shadows ? shadows_[c].Remove(frames[c], r.mask, r.darker) : r.mask;
+    cf.light_level = r.light_level;
+    cf.blobs_removed = r.blobs_removed;
+  });
+  out.ms_silhouettes = since(t);
   std::vector<cv::Mat> silhouettes;
   for (const CameraFeatures& cf : out.cameras) silhouettes.push_back(cf.silhouette);
-  auto t = std::chrono::steady_clock::now();
-  for (const cv::Mat& s : silhouettes) out.polygons.push_back(ApproximateSilhouette(s, options_.polygons));
+  // Each silhouette's distance transform, for the 3D axes' silhouette test
+  // and the voxel carving: made in the first stage that needs it.
+  std::vector<cv::Mat> distances;
+  auto make_distances = [&] {
+    if (!distances.empty()) return;
+    distances.resize(nc);
+    per_camera([&](int c) { distances[c] = DistanceToSilhouette(silhouettes[c]); });
+  };
+  if (options_.find_axes) {
+    t = std::chrono::steady_clock::now();
+    make_distances();
+    out.axis3d = ReconstructBodyAxes(cameras_, silhouettes, options_.axes, &out.views, &distances);
+    out.ms_axes = since(t);
+  }
+  t = std::chrono::steady_clock::now();
+  out.polygons.resize(nc);
+  per_camera([&](int c) { out.polygons[c] = ApproximateSilhouette(silhouettes[c], options_.polygons); });
   out.ms_polygons = since(t);
   if (carver_) {
     t = std::chrono::steady_clock::now();
-    out.voxels = carver_->Carve(silhouettes);
+    make_distances();
+    out.voxels = carver_->CarveDistances(distances);
     out.placement = PlaceBody(*out.voxels);
     if (!out.placement && options_.placement_drop_view && silhouettes.size() >= 4 &&
         options_.voxels.max_missing_views == 0) {
-      out.placement = PlaceBodyWithoutOneView(*carver_, silhouettes, options_.placement_max_coverage);
+      out.placement = PlaceBodyWithoutOneView(*carver_, silhouettes, options_.placement_max_coverage, &distances);
     }
     out.ms_voxels = since(t);
   }

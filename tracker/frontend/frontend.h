@@ -76,9 +76,11 @@ std::optional<BodyPlacement> PlaceBody(const VoxelHull& hull, double legs_height
 // camera c with any silhouette, the hull of the others (c's image taken as
 // all silhouette) and the share of that hull's voxel centres c's silhouette
 // covers; the camera covering least, when below `max_coverage`. nullopt when
-// no camera qualifies.
+// no camera qualifies. `distances`: the silhouettes' DistanceToSilhouette
+// when the caller has them (computed otherwise).
 std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, const std::vector<cv::Mat>& silhouettes,
-                                                     double max_coverage);
+                                                     double max_coverage,
+                                                     const std::vector<cv::Mat>* distances = nullptr);
 
 struct FrameFeatures {
   int frame = 0;
@@ -106,7 +108,10 @@ class FrontEnd {
  public:
   // Throws InputError when the sequence has no empty-stage frames.
   static FrontEnd Train(const SequenceInput& input, const FrontEndOptions& options);
-  // `frames`: one 8-bit image per camera, in the input's camera order.
+  // `frames`: one 8-bit image per camera, in the input's camera order, of
+  // the camera's size (std::invalid_argument otherwise). The per-camera
+  // stages run in parallel over the cameras; the result does not depend on
+  // the thread count.
   FrameFeatures Process(int frame, const std::vector<cv::Mat>& frames) const;
 
   const FrontEndOptions& options() const { return options_; }

@@ -1,9 +1,11 @@
 #include "tracker/hull/voxel_hull.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
@@ -247,6 +249,18 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
   }
 }
 
+cv::Mat DistanceToSilhouette(const cv::Mat& silhouette) {
+  CV_Assert(silhouette.type() == CV_8UC1);
+  cv::Mat background, out;
+  cv::threshold(silhouette, background, 127, 255, cv::THRESH_BINARY_INV);
+  if (cv::countNonZero(background) == static_cast<int>(background.total())) {
+    return cv::Mat(silhouette.size(), CV_32F, cv::Scalar(1e6));  // no silhouette: all far
+  }
+  cv::distanceTransform(background, out, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  CV_Assert(out.isContinuous());
+  return out;
+}
+
 std::vector<cv::Mat> VoxelCarver::DistanceTransforms(const std::vector<cv::Mat>& silhouettes) const {
   const size_t nc = cameras_.size();
   if (silhouettes.size() != nc) {
@@ -255,22 +269,13 @@ std::vector<cv::Mat> VoxelCarver::DistanceTransforms(const std::vector<cv::Mat>&
                          std::to_string(silhouettes.size()));
   }
   std::vector<cv::Mat> out(nc);
-  cv::Mat background;
   for (size_t c = 0; c < nc; ++c) {
     const cv::Mat& sil = silhouettes[c];
     if (sil.type() != CV_8UC1 || sil.cols != cameras_[c].width || sil.rows != cameras_[c].height) {
       throw InputError("", "silhouettes[" + std::to_string(c) + "]",
                        "must be CV_8UC1 of the camera's size");
     }
-    // Distance from each pixel centre to the nearest silhouette pixel centre
-    // (exact Euclidean), pixels.
-    cv::threshold(sil, background, 127, 255, cv::THRESH_BINARY_INV);
-    if (cv::countNonZero(background) == static_cast<int>(background.total())) {
-      out[c] = cv::Mat(sil.size(), CV_32F, cv::Scalar(1e6));  // no silhouette: all far
-    } else {
-      cv::distanceTransform(background, out[c], cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-    }
-    CV_Assert(out[c].isContinuous());
+    out[c] = DistanceToSilhouette(sil);
   }
   return out;
 }
@@ -303,50 +308,69 @@ inline bool Passes(const float* dist, int w, const Footprint& f) {
 }  // namespace
 
 VoxelHull VoxelCarver::Carve(const std::vector<cv::Mat>& silhouettes) const {
-  const std::vector<cv::Mat> distance = DistanceTransforms(silhouettes);
-  VoxelHull hull = EmptyHull();
+  return CarveDistances(DistanceTransforms(silhouettes));
+}
+
+VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) const {
   const size_t nc = cameras_.size();
+  if (distances.size() != nc) {
+    throw InputError("", "distances",
+                     "expected " + std::to_string(nc) + " distance transforms, got " +
+                         std::to_string(distances.size()));
+  }
   std::vector<const float*> dist(nc);
   std::vector<int> width(nc);
   for (size_t c = 0; c < nc; ++c) {
-    dist[c] = distance[c].ptr<float>();
+    const cv::Mat& d = distances[c];
+    if (d.type() != CV_32FC1 || d.cols != cameras_[c].width || d.rows != cameras_[c].height || !d.isContinuous()) {
+      throw InputError("", "distances[" + std::to_string(c) + "]",
+                       "must be a continuous CV_32FC1 of the camera's size");
+    }
+    dist[c] = d.ptr<float>();
     width[c] = cameras_[c].width;
   }
+  VoxelHull hull = EmptyHull();
   const int allowed = options_.max_missing_views;
-  std::vector<int> unsure(nc);  // the cameras to consult per voxel
-  int occupied = 0;
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    const BlockBound* bound = bounds_.data() + b * nc;
-    int carved = 0, n_unsure = 0;
-    for (size_t c = 0; c < nc; ++c) {
-      const float d = dist[c][bound[c].pixel];
-      if (d > bound[c].carve_above) {
-        ++carved;
-      } else if (!(d <= bound[c].keep_below)) {
-        unsure[n_unsure++] = static_cast<int>(c);
+  std::atomic<int> occupied{0};
+  // Blocks write disjoint voxels: ranges of them run in parallel.
+  const int n_blocks = static_cast<int>(blocks_.size());
+  cv::parallel_for_(cv::Range(0, n_blocks), [&](const cv::Range& range) {
+    std::vector<int> unsure(nc);  // the cameras to consult per voxel
+    int count = 0;
+    for (int b = range.start; b < range.end; ++b) {
+      const BlockBound* bound = bounds_.data() + size_t(b) * nc;
+      int carved = 0, n_unsure = 0;
+      for (size_t c = 0; c < nc; ++c) {
+        const float d = dist[c][bound[c].pixel];
+        if (d > bound[c].carve_above) {
+          ++carved;
+        } else if (!(d <= bound[c].keep_below)) {
+          unsure[n_unsure++] = static_cast<int>(c);
+        }
+      }
+      if (carved > allowed) continue;
+      const Block& block = blocks_[b];
+      const uint32_t end = block.first + block.count;
+      if (n_unsure == 0) {
+        for (uint32_t k = block.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+        count += static_cast<int>(block.count);
+        continue;
+      }
+      for (uint32_t k = block.first; k < end; ++k) {
+        const Footprint* fp = footprints_.data() + size_t(k) * nc;
+        int misses = carved;
+        for (int i = 0; i < n_unsure && misses <= allowed; ++i) {
+          const int c = unsure[i];
+          misses += !Passes(dist[c], width[c], fp[c]);
+        }
+        if (misses <= allowed) {
+          hull.occupied[candidates_[k]] = 1;
+          ++count;
+        }
       }
     }
-    if (carved > allowed) continue;
-    const Block& block = blocks_[b];
-    const uint32_t end = block.first + block.count;
-    if (n_unsure == 0) {
-      for (uint32_t k = block.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
-      occupied += static_cast<int>(block.count);
-      continue;
-    }
-    for (uint32_t k = block.first; k < end; ++k) {
-      const Footprint* fp = footprints_.data() + size_t(k) * nc;
-      int misses = carved;
-      for (int i = 0; i < n_unsure && misses <= allowed; ++i) {
-        const int c = unsure[i];
-        misses += !Passes(dist[c], width[c], fp[c]);
-      }
-      if (misses <= allowed) {
-        hull.occupied[candidates_[k]] = 1;
-        ++occupied;
-      }
-    }
-  }
+    occupied += count;
+  }, 8);
   hull.occupied_count = occupied;
   return hull;
 }

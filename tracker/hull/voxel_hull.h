@@ -79,6 +79,11 @@ struct VoxelHull {
 // Precomputes the voxel-to-pixel table for one rig and grid (thesis 4.2: "the
 // camera calibration parameters allow us to pre-compute a look-up table"), then
 // carves any number of silhouette sets with it.
+// Per pixel centre, the exact Euclidean distance in pixels to the nearest
+// pixel centre of `silhouette` (CV_8UC1, > 127 is silhouette), CV_32F and
+// continuous; 1e6 everywhere when the silhouette is empty.
+cv::Mat DistanceToSilhouette(const cv::Mat& silhouette);
+
 class VoxelCarver {
  public:
   // Throws InputError for bad options or no cameras. Cost: about two
@@ -97,6 +102,13 @@ class VoxelCarver {
   // is not consulted for its voxels; only the rest go through the per-voxel
   // test. The result is bit-identical to CarveReference().
   VoxelHull Carve(const std::vector<cv::Mat>& silhouettes) const;
+
+  // The same from the silhouettes' distance transforms (DistanceToSilhouette
+  // per camera), for a caller that needs them too: the transform is the
+  // carving's largest cost. Throws InputError on a count, size or type
+  // mismatch. The blocks are carved in parallel; the result does not depend
+  // on the thread count.
+  VoxelHull CarveDistances(const std::vector<cv::Mat>& distances) const;
 
   // The same occupancy by the plain evaluation of every candidate voxel in
   // every camera, without the block bounds: the reference for tests; slow.

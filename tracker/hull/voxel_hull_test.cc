@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <opencv2/core/utility.hpp>
 #include <random>
 #include <string>
 
@@ -284,6 +285,15 @@ TEST(VoxelHullTest, CoarseToFineEqualsThePerVoxelReference) {
       const VoxelHull reference = carver.CarveReference(sil);
       EXPECT_EQ(fast.occupied_count, reference.occupied_count);
       EXPECT_TRUE(fast.occupied == reference.occupied);
+      // The blocks are carved in parallel: one thread gives the same hull.
+      const int threads = cv::getNumThreads();
+      cv::setNumThreads(1);
+      std::vector<cv::Mat> distances;
+      for (const cv::Mat& m : sil) distances.push_back(DistanceToSilhouette(m));
+      const VoxelHull serial = carver.CarveDistances(distances);
+      cv::setNumThreads(threads);
+      EXPECT_EQ(serial.occupied_count, reference.occupied_count);
+      EXPECT_TRUE(serial.occupied == reference.occupied);
       int counted = 0;
       for (uint8_t o : fast.occupied) counted += o;
       EXPECT_EQ(counted, fast.occupied_count);
@@ -322,6 +332,11 @@ TEST(VoxelHullTest, RejectsBadInput) {
   const VoxelCarver carver(cams, coarse);
   EXPECT_THROW(carver.Carve({cv::Mat::zeros(240, 320, CV_8UC1)}), InputError);
   EXPECT_THROW(carver.Carve({cv::Mat::zeros(240, 320, CV_8UC1), cv::Mat::zeros(100, 320, CV_8UC1)}),
+               InputError);
+  EXPECT_THROW(carver.CarveDistances({cv::Mat::zeros(240, 320, CV_32F)}), InputError);
+  EXPECT_THROW(carver.CarveDistances({cv::Mat::zeros(240, 320, CV_32F), cv::Mat::zeros(240, 320, CV_8U)}),
+               InputError);
+  EXPECT_THROW(carver.CarveDistances({cv::Mat::zeros(240, 320, CV_32F), cv::Mat::zeros(240, 300, CV_32F)}),
                InputError);
   const VoxelHull hull =
       carver.Carve({cv::Mat::zeros(240, 320, CV_8UC1), cv::Mat::zeros(240, 320, CV_8UC1)});
