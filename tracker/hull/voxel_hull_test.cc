@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
@@ -313,6 +314,44 @@ TEST(VoxelHullTest, CoarseToFineEqualsThePerVoxelReference) {
     }
     EXPECT_GE(carver.CarveReference(test.silhouette_sets[0]).occupied_count, test.min_occupied);
   }
+}
+
+TEST(VoxelHullTest, DistanceToSilhouetteEqualsOpenCvsExactTransform) {
+  std::mt19937 rng(5);
+  std::vector<cv::Mat> masks;
+  cv::Mat one = cv::Mat::zeros(240, 320, CV_8UC1);
+  one.at<uint8_t>(7, 311) = 255;
+  masks.push_back(one);
+  masks.push_back(cv::Mat(240, 320, CV_8UC1, cv::Scalar(255)));
+  cv::Mat body = cv::Mat::zeros(240, 320, CV_8UC1);
+  cv::ellipse(body, {160, 130}, {22, 45}, 0, 0, 360, 255, cv::FILLED);
+  cv::line(body, {150, 100}, {95, 40}, 255, 8);
+  cv::line(body, {170, 165}, {180, 239}, 255, 14);
+  masks.push_back(body);
+  for (double density : {0.0005, 0.01, 0.3}) {  // scattered pixels, the image borders included
+    cv::Mat m(173, 251, CV_8UC1);
+    cv::randu(m, 0, 255);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int y = 0; y < m.rows; ++y) {
+      for (int x = 0; x < m.cols; ++x) m.at<uint8_t>(y, x) = u(rng) < density ? 200 : 100;
+    }
+    masks.push_back(m);
+  }
+  for (size_t i = 0; i < masks.size(); ++i) {
+    SCOPED_TRACE("mask " + std::to_string(i));
+    cv::Mat background, expected;
+    cv::threshold(masks[i], background, 127, 255, cv::THRESH_BINARY_INV);
+    cv::distanceTransform(background, expected, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+    const cv::Mat got = DistanceToSilhouette(masks[i]);
+    ASSERT_EQ(got.type(), CV_32FC1);
+    ASSERT_EQ(got.size(), masks[i].size());
+    EXPECT_TRUE(got.isContinuous());
+    EXPECT_EQ(cv::norm(got, expected, cv::NORM_INF), 0);  // bit for bit
+  }
+  // No silhouette: everything far.
+  double lo = 0;
+  cv::minMaxLoc(DistanceToSilhouette(cv::Mat::zeros(240, 320, CV_8UC1)), &lo);
+  EXPECT_GE(lo, 1e5);
 }
 
 TEST(VoxelHullTest, RejectsBadInput) {

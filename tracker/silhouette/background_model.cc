@@ -116,6 +116,7 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     regress = false;
     dof = fit(false);
   }
+  m.light_pixel_count_ = cv::countNonZero(m.light_pixels_);
   // The pooled difference's noise, measured where it is used.
   if (flicker && options.pool_sigma > 0) {
     double sum_sq = 0;
@@ -175,9 +176,9 @@ cv::Mat BackgroundModel::Expected(double light) const {
 }
 
 double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
-  if (cv::countNonZero(light_pixels_) < kMinLightPixels) return mean_light_;
-  std::vector<float> estimates;
-  estimates.reserve(static_cast<size_t>(cv::countNonZero(light_pixels_)));
+  if (light_pixel_count_ < kMinLightPixels) return mean_light_;
+  thread_local std::vector<float> estimates;
+  estimates.clear();
   // Every other row and column: a quarter of the pixels is plenty for a median.
   for (int y = 0; y < frame.rows; y += 2) {
     const uint8_t* ip = frame.ptr<uint8_t>(y);
@@ -210,8 +211,22 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
     cv::Mat pooled;
     cv::GaussianBlur(z, pooled, cv::Size(), PoolSigmaPx(frame.cols));
     // Hysteresis: weak pooled evidence counts where it connects to strong.
-    const cv::Mat strong = (cv::abs(pooled) > options_.pool_threshold * pooled_noise_) | r.raw;
-    const cv::Mat weak = (cv::abs(pooled) > options_.pool_weak_threshold * pooled_noise_) | strong;
+    // strong = |pooled| > pool threshold or raw; weak = |pooled| > the weak
+    // threshold or strong (thresholds in float, as cv::compare takes them).
+    const float strong_above = static_cast<float>(options_.pool_threshold * pooled_noise_);
+    const float weak_above = static_cast<float>(options_.pool_weak_threshold * pooled_noise_);
+    cv::Mat strong(pooled.size(), CV_8U), weak(pooled.size(), CV_8U);
+    for (int y = 0; y < pooled.rows; ++y) {
+      const float* pp = pooled.ptr<float>(y);
+      const uint8_t* rp = r.raw.ptr<uint8_t>(y);
+      uint8_t* sp = strong.ptr<uint8_t>(y);
+      uint8_t* wp = weak.ptr<uint8_t>(y);
+      for (int x = 0; x < pooled.cols; ++x) {
+        const float a = std::abs(pp[x]);
+        sp[x] = a > strong_above || rp[x] ? 255 : 0;
+        wp[x] = a > weak_above || sp[x] ? 255 : 0;
+      }
+    }
     cv::Mat labels;
     const int count = cv::connectedComponents(weak, labels, 8, CV_32S);
     std::vector<uint8_t> keep(count, 0);

@@ -81,7 +81,7 @@ class BackgroundModel {
   const cv::Mat& b() const { return b_; }
   const cv::Mat& sigma() const { return sigma_; }
   // Pixels L(t) is read from (0 for the plain model: L is the training mean).
-  int light_pixel_count() const { return light_pixels_.empty() ? 0 : cv::countNonZero(light_pixels_); }
+  int light_pixel_count() const { return light_pixel_count_; }
   double mean_light() const { return mean_light_; }
   // The expected empty-stage image at light level `light`.
   cv::Mat Expected(double light) const;
@@ -97,6 +97,7 @@ class BackgroundModel {
   double PoolSigmaPx(int width) const { return options_.pool_sigma * width / 320.0; }
 
   cv::Mat light_pixels_;  // CV_8U: pixels whose b is large enough to read L from
+  int light_pixel_count_ = 0;
   cv::Mat screen_;        // CV_8U: screen pixels (may be empty)
   cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;

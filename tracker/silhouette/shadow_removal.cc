@@ -91,48 +91,62 @@ cv::Mat KeepEnclosed(const cv::Mat& silhouette, const cv::Mat& edges, int min_di
   const int w = silhouette.cols, h = silhouette.rows;
   cv::Mat votes = cv::Mat::zeros(silhouette.size(), CV_8U);
   const int dirs[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
-  std::vector<cv::Point> line;
-  for (const auto& d : dirs) {
-    const int dx = d[0], dy = d[1];
-    // Start points: every pixel whose predecessor along (dx, dy) is outside.
-    for (int y0 = 0; y0 < h; ++y0) {
-      for (int x0 = 0; x0 < w; ++x0) {
-        const int px = x0 - dx, py = y0 - dy;
-        if (px >= 0 && px < w && py >= 0 && py < h) continue;
-        line.clear();
-        for (int x = x0, y = y0; x >= 0 && x < w && y >= 0 && y < h; x += dx, y += dy) line.push_back({x, y});
-        // Runs of silhouette pixels along the line.
-        for (size_t i = 0; i < line.size();) {
-          if (!silhouette.at<uint8_t>(line[i])) {
-            ++i;
-            continue;
-          }
-          size_t j = i;
-          while (j < line.size() && silhouette.at<uint8_t>(line[j])) ++j;
-          // Run [i, j): first and last segmented edge, within `reach` outside
-          // the run too (the outline's edge may sit on the background side).
-          const long lo = std::max<long>(0, static_cast<long>(i) - reach);
-          const long hi = std::min<long>(static_cast<long>(line.size()), static_cast<long>(j) + reach);
-          long first = -1, last = -1;
-          for (long k = lo; k < hi; ++k) {
-            if (edges.at<uint8_t>(line[k])) {
-              if (first < 0) first = k;
-              last = k;
-            }
-          }
-          if (first >= 0) {
-            for (long k = std::max<long>(first, static_cast<long>(i)); k <= std::min<long>(last, static_cast<long>(j) - 1); ++k) {
-              ++votes.at<uint8_t>(line[k]);
-            }
-          }
-          i = j;
+  // Every pixel lies on one line per direction; a pixel of a silhouette run
+  // gets a vote from the direction when edges enclose it along the line.
+  // One scan line: from (x0, y0) along (dx, dy) to the image's border.
+  auto scan = [&](int x0, int y0, int dx, int dy) {
+    int n = dx == 0 ? h - y0 : w - x0;
+    if (dy > 0) n = std::min(n, h - y0);
+    if (dy < 0) n = std::min(n, y0 + 1);
+    const uint8_t* sil = silhouette.ptr<uint8_t>(y0) + x0;
+    const uint8_t* edge = edges.ptr<uint8_t>(y0) + x0;
+    uint8_t* vote = votes.ptr<uint8_t>(y0) + x0;
+    const ptrdiff_t sil_step = dy * static_cast<ptrdiff_t>(silhouette.step) + dx;
+    const ptrdiff_t edge_step = dy * static_cast<ptrdiff_t>(edges.step) + dx;
+    const ptrdiff_t vote_step = dy * static_cast<ptrdiff_t>(votes.step) + dx;
+    // Runs of silhouette pixels along the line.
+    for (int i = 0; i < n;) {
+      if (!sil[i * sil_step]) {
+        ++i;
+        continue;
+      }
+      int j = i;
+      while (j < n && sil[j * sil_step]) ++j;
+      // Run [i, j): first and last segmented edge, within `reach` outside
+      // the run too (the outline's edge may sit on the background side).
+      const int lo = std::max(0, i - reach), hi = std::min(n, j + reach);
+      int first = -1, last = -1;
+      for (int k = lo; k < hi; ++k) {
+        if (edge[k * edge_step]) {
+          if (first < 0) first = k;
+          last = k;
         }
       }
+      if (first >= 0) {
+        for (int k = std::max(first, i); k <= std::min(last, j - 1); ++k) ++vote[k * vote_step];
+      }
+      i = j;
+    }
+  };
+  for (const auto& d : dirs) {
+    const int dx = d[0], dy = d[1];
+    // Start points: the pixels whose predecessor along (dx, dy) is outside:
+    // the left column when dx = 1, and the first row (dy = 1) or the last
+    // (dy = -1).
+    if (dx == 1) {
+      for (int y0 = 0; y0 < h; ++y0) scan(0, y0, dx, dy);
+    }
+    if (dy != 0) {
+      for (int x0 = dx; x0 < w; ++x0) scan(x0, dy > 0 ? 0 : h - 1, dx, dy);
     }
   }
-  cv::Mat out = cv::Mat::zeros(silhouette.size(), CV_8U);
-  out.setTo(255, votes >= min_directions);
-  out.setTo(0, silhouette == 0);
+  cv::Mat out(silhouette.size(), CV_8U);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* vp = votes.ptr<uint8_t>(y);
+    const uint8_t* sp = silhouette.ptr<uint8_t>(y);
+    uint8_t* op = out.ptr<uint8_t>(y);
+    for (int x = 0; x < w; ++x) op[x] = sp[x] && vp[x] >= min_directions ? 255 : 0;
+  }
   return out;
 }
 
