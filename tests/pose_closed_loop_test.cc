@@ -178,25 +178,26 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   // Issue 7's bars are 5 cm for shoulders, elbows and wrists, 4 cm for waist
   // and neck, 5 cm for the root, 3 deg pointing. Measured on these frames,
   // seeds 1-3 pooled (the issue note), with the rest-state SVM, the waist
-  // cap and the girth up to 2.4: arm joints 3.1-5.0 cm, waist 5.0, neck 3.5,
-  // root 5.3, pointing 2.2 deg (small changes move these by about half a
-  // centimetre either way). The
+  // cap, the girth up to 2.4 and the spine behind the trunk's middle: arm
+  // joints 2.5-3.9 cm, waist 3.9, neck 2.8, root 3.0, pointing 2.5 deg
+  // (small changes move these by about half a centimetre either way). The
   // thresholds guard that with a margin; the bars not yet met are named in
   // the issue note.
   for (const char* arm : {"left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist",
                           "right_wrist"}) {
     if (errors[arm].size() < 30) continue;  // an arm that never moved
-    EXPECT_LT(Mean(errors[arm]), 0.075) << arm;
+    EXPECT_LT(Mean(errors[arm]), 0.06) << arm;
   }
-  EXPECT_LT(Mean(errors["waist"]), 0.06);
-  EXPECT_LT(Mean(errors["neck"]), 0.055);
-  EXPECT_LT(Mean(errors["root"]), 0.065);
+  EXPECT_LT(Mean(errors["waist"]), 0.05);
+  EXPECT_LT(Mean(errors["neck"]), 0.045);
+  EXPECT_LT(Mean(errors["root"]), 0.045);
   ASSERT_GT(pointing_deg.size(), 30u);
-  EXPECT_LT(Mean(pointing_deg), 4.0);
-  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.3 % (the
-  // SVM alone, without the likelihood-ratio test: 90.8 %).
+  EXPECT_LT(Mean(pointing_deg), 3.5);
+  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.6 % (the
+  // SVM alone, without the likelihood-ratio test: 90.8 % before the spine
+  // offset).
   EXPECT_GT(rest_total, 1000);
-  EXPECT_GT(rest_accuracy, 0.95);
+  EXPECT_GT(rest_accuracy, 0.96);
 }
 
 // Thesis 6.6 reports recovery in 2-3 frames after a loss: scatter the

@@ -87,6 +87,8 @@ BodyShape BodyShape::FromHeight(double h, double girth) {
   s.waist_height_m = 0.600 * h;
   s.torso_length_m = 0.218 * h;
   s.shoulder_offset_m = 0.100 * h;
+  s.spine_depth_m = 0.008 * h;
+  s.ankle_setback_m = 0.010 * h;
   s.shoulder_height_m = 0.210 * h;
   s.head_offset_m = 0.117 * h;
   s.upper_arm_m = 0.186 * h;
@@ -153,8 +155,8 @@ PosedBody PoseBody(const BodyShape& shape, const BodyPose& pose) {
 
   out.joints[kModelWaist] = waist;
   out.joints[kModelNeck] = neck;
-  out.joints[kModelHead] = neck + world_from_head * Vector3d(0, 0, shape.head_offset_m);
-  const Vector3d leg_end = waist + world_from_body * Vector3d(0, 0, -shape.waist_height_m);
+  out.joints[kModelHead] = neck + world_from_head * Vector3d(0, shape.spine_depth_m, shape.head_offset_m);
+  const Vector3d leg_end = waist + world_from_body * Vector3d(0, -shape.ankle_setback_m, -shape.waist_height_m);
   out.joints[kModelRoot] = Vector3d(leg_end.x(), leg_end.y(), 0.0);
 
   for (int side = 0; side < 2; ++side) {  // 0 right, 1 left
@@ -180,7 +182,8 @@ PosedBody PoseBody(const BodyShape& shape, const BodyPose& pose) {
   for (int s = 0; s < kSegmentCount; ++s) {
     Ellipsoid& e = out.segments[s];
     e.world_from_segment = out.frames[s].linear();
-    e.center = out.frames[s] * Vector3d(0, 0, shape.center_along[s]);
+    const bool trunk = s == kLowerBody || s == kUpperBody || s == kHeadSegment;
+    e.center = out.frames[s] * Vector3d(0, trunk ? shape.spine_depth_m : 0.0, shape.center_along[s]);
     e.radii = shape.radii[s];
   }
   return out;
@@ -261,8 +264,9 @@ bool ClampToJointLimits(BodyPose* pose) {
 
 BodyPose StandingPose(const BodyShape& shape, const Eigen::Vector2d& root_xy, double yaw) {
   BodyPose p;
-  p.dof[kDofX] = root_xy.x();
-  p.dof[kDofY] = root_xy.y();
+  // The waist stands ankle_setback_m ahead (+y of the body) of the root.
+  p.dof[kDofX] = root_xy.x() - shape.ankle_setback_m * std::sin(yaw);
+  p.dof[kDofY] = root_xy.y() + shape.ankle_setback_m * std::cos(yaw);
   p.dof[kDofZ] = shape.waist_height_m;
   p.dof[kDofYaw] = yaw;
   // Arms hang slightly away from the body.

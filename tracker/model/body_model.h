@@ -79,6 +79,15 @@ struct BodyShape {
   double upper_arm_m = 0;        // shoulder to elbow
   double forearm_m = 0;          // elbow to wrist
   double hand_m = 0;             // wrist to hand tip
+  // The spine's joints lie behind the trunk's middle: the lower body's,
+  // upper body's and head's ellipsoids sit this far forward (their frames'
+  // y) of the joints they hang from (the head centre with its ellipsoid).
+  // And the ankles, whose midpoint's floor point is the root, stand this far
+  // behind the waist. Both from the truth joints' place in the sim's avatars
+  // (docs/tracker.md): with the ellipsoids on the joints, the tracked waist
+  // sat 2.7 cm ahead of the truth's.
+  double spine_depth_m = 0;
+  double ankle_setback_m = 0;
   // Ellipsoid semi-axes (x, y, z in the segment's frame; z along the segment).
   std::array<Eigen::Vector3d, kSegmentCount> radii;
   // Ellipsoid centre along the segment's z axis from its joint (negative:

@@ -17,6 +17,17 @@ TEST(BodyModel, StandingPoseHasTheProportionsItWasScaledTo) {
   EXPECT_NEAR(body.joints[kModelWaist].z(), 0.600 * 1.80, 1e-12);
   EXPECT_NEAR(body.joints[kModelNeck].z(), 0.818 * 1.80, 1e-12);
   EXPECT_NEAR(body.joints[kModelHead].z(), 0.935 * 1.80, 1e-12);
+  // The spine's joints lie behind the trunk's middle (facing +y), the ankles
+  // behind the waist: the root is the floor point under them.
+  EXPECT_GT(shape.spine_depth_m, 0.01);
+  EXPECT_GT(shape.ankle_setback_m, 0.01);
+  for (int seg : {kLowerBody, kUpperBody, kHeadSegment}) {
+    const Vector3d off = body.segments[seg].center - (seg == kHeadSegment ? body.joints[kModelNeck] : body.joints[kModelWaist]);
+    EXPECT_NEAR(off.y(), shape.spine_depth_m, 1e-12) << BodySegmentName(seg);
+    EXPECT_NEAR(off.x(), 0, 1e-12) << BodySegmentName(seg);
+  }
+  EXPECT_NEAR(body.joints[kModelRoot].y() - body.joints[kModelWaist].y(), -shape.ankle_setback_m, 1e-12);
+  EXPECT_NEAR((body.joints[kModelHead] - body.segments[kHeadSegment].center).norm(), 0, 1e-12);
   // The head ellipsoid reaches the stature.
   EXPECT_NEAR(body.segments[kHeadSegment].center.z() + body.segments[kHeadSegment].radii.z(), 1.80, 0.01);
   // Facing +y, the right arm is on the +x side and hangs.

@@ -328,9 +328,11 @@ TEST(RestState, TheShippedModelLoadsAndKnowsHangingFromPointing) {
 namespace irbench {
 namespace {
 
-// FlippedPose is the front/back twin: turned half way round, each arm is
-// where the other side's arm was (same world positions), so only the
-// ellipsoid torso's orientation differs — which silhouettes barely show.
+// FlippedPose is the front/back twin: turned half way round about the spine,
+// each arm is where the other side's arm was (same world positions), so only
+// the ellipsoid torso's orientation differs — which silhouettes barely show —
+// and what sits off the spine line is mirrored through it: the head centre
+// (spine_depth_m ahead of it) and the root (ankle_setback_m behind it).
 TEST(PoseTracker, FlippedPoseKeepsTheArmsWhereTheyWere) {
   const BodyShape shape = BodyShape::FromHeight(1.8);
   std::mt19937 rng(12);
@@ -353,9 +355,12 @@ TEST(PoseTracker, FlippedPoseKeepsTheArmsWhereTheyWere) {
     const PosedBody a = PoseBody(shape, pose), b = PoseBody(shape, flipped);
     for (auto [from, to] : {std::pair{kModelRightShoulder, kModelLeftShoulder}, {kModelRightElbow, kModelLeftElbow},
                             {kModelRightWrist, kModelLeftWrist}, {kModelLeftHandTip, kModelRightHandTip},
-                            {kModelHead, kModelHead}, {kModelRoot, kModelRoot}}) {
+                            {kModelNeck, kModelNeck}, {kModelWaist, kModelWaist}}) {
       EXPECT_LT((b.joints[to] - a.joints[from]).norm(), 1e-9) << ModelJointName(from) << " trial " << trial;
     }
+    const Eigen::Vector3d forward(-std::sin(pose.dof[kDofYaw]), std::cos(pose.dof[kDofYaw]), 0);
+    EXPECT_LT((b.joints[kModelHead] - (a.joints[kModelHead] - 2 * shape.spine_depth_m * forward)).norm(), 1e-9);
+    EXPECT_LT((b.joints[kModelRoot] - (a.joints[kModelRoot] + 2 * shape.ankle_setback_m * forward)).norm(), 1e-9);
   }
 }
 

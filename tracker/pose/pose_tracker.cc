@@ -410,8 +410,11 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     if (walking_) next.dof[kDofYaw] = YawFacing(velocity_xy_.normalized()) + 0.1 * n01(rng_);
     const Vector2d noise(0.02 * n01(rng_), 0.02 * n01(rng_));
     if (!torso_xy_.empty()) {
+      // The axis runs through the trunk's middle, the spine (the waist
+      // joint) spine_depth_m behind it.
       std::uniform_int_distribution<size_t> pick(0, torso_xy_.size() - 1);
-      const Vector2d xy = torso_xy_[pick(rng_)] + noise;
+      const double yaw = next.dof[kDofYaw];
+      const Vector2d xy = torso_xy_[pick(rng_)] + noise - shape_.spine_depth_m * Vector2d(-std::sin(yaw), std::cos(yaw));
       next.dof[kDofX] = xy.x();
       next.dof[kDofY] = xy.y();
     } else {
