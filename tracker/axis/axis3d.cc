@@ -291,6 +291,8 @@ std::vector<AxisPoint3d> ReconstructBodyAxes(const std::vector<Camera>& cameras,
     }
   });
   std::vector<AxisPoint3d> points = ReconstructAxis3d(views, options.axis3d);
+  // The caller's distance maps stay with the caller (four floats a pixel).
+  for (AxisView& view : views) view.distance_to_silhouette.release();
   if (views_out) *views_out = std::move(views);
   return points;
 }

@@ -25,8 +25,9 @@ struct AxisView {
   // only checks other views' 3D points against its silhouette.
   std::vector<BodyPart> labels;
   // Optional, CV_32FC1 of the camera's size: each pixel's distance to the
-  // nearest silhouette pixel (as DistanceToSilhouette in tracker/hull), when
-  // the caller has it; computed from `silhouette` when empty.
+  // nearest silhouette pixel (> 0), when the caller has it; computed from
+  // `silhouette` when empty. For 0/255 masks DistanceToSilhouette (in
+  // tracker/hull, > 127 is silhouette) gives the same.
   cv::Mat distance_to_silhouette;
 };
 

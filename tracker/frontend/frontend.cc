@@ -83,6 +83,11 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
 
 std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, const std::vector<cv::Mat>& silhouettes,
                                                      double max_coverage, const std::vector<cv::Mat>* distances) {
+  if (distances && distances->size() != silhouettes.size()) {
+    throw InputError("", "distances",
+                     "expected " + std::to_string(silhouettes.size()) + " distance transforms, got " +
+                         std::to_string(distances->size()));
+  }
   std::vector<cv::Mat> own;
   if (!distances) {
     for (const cv::Mat& s : silhouettes) own.push_back(DistanceToSilhouette(s));

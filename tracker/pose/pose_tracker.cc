@@ -311,7 +311,12 @@ BodyPose PoseTracker::TurnedPose(const BodyPose& current, double yaw) const {
   BodyPose next = current;
   next.dof[kDofYaw] = yaw;
   next.dof[kDofWaistZ] = 0;
-  PlaceRoot(shape_, &next, body.joints[kModelRoot].head<2>());
+  // Turned about the trunk's axis (the lower body's ellipsoid stays where
+  // the silhouettes put it; the spine lies spine_depth_m behind it).
+  const Vector2d trunk = body.segments[kLowerBody].center.head<2>();
+  const Vector2d moved = PoseBody(shape_, next).segments[kLowerBody].center.head<2>();
+  next.dof[kDofX] += trunk.x() - moved.x();
+  next.dof[kDofY] += trunk.y() - moved.y();
   const struct {
     int segment, shoulder, elbow, wrist;
   } arms[] = {{kRightUpperArm, kModelRightShoulder, kModelRightElbow, kModelRightWrist},
@@ -404,8 +409,8 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     next.dof[kDofRightShoulderTwist] = next.dof[kDofLeftShoulderTwist] = 0.0;
   } else if (choice < options_.p_random_walk + options_.p_body_position) {
     // Body position (thesis 6.3.2): the x and y of a random 3D torso axis
-    // point (the waist stands under the torso's axis), else the voxel hull's
-    // root; while the user walks, the heading from the hull's motion (people
+    // point (the trunk's middle, the waist spine_depth_m behind it), else the
+    // voxel hull's root; while the user walks, the heading from the hull's motion (people
     // face where they walk).
     if (walking_) next.dof[kDofYaw] = YawFacing(velocity_xy_.normalized()) + 0.1 * n01(rng_);
     const Vector2d noise(0.02 * n01(rng_), 0.02 * n01(rng_));

@@ -124,8 +124,11 @@ struct PoseEstimate {
 // Descriptor & Posture Recognition Function"): poses to seed particles with.
 using PoseProposalHook = std::function<std::vector<BodyPose>(const FrameFeatures&, const BodyShape&)>;
 
-// The front/back twin of `pose`: turned by pi about z, the arms swapped and
-// mirrored, so that its silhouettes are nearly those of `pose`.
+// The front/back twin of `pose`: turned by pi about z through the waist
+// joint, the arms swapped and mirrored, so that its silhouettes are nearly
+// those of `pose`: the arms land exactly where they were, the trunk and head
+// (spine_depth_m ahead of the spine) move by twice that, a few centimetres
+// the filter's next steps take up.
 BodyPose FlippedPose(const BodyPose& pose);
 
 class PoseTracker {
