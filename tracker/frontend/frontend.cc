@@ -90,7 +90,7 @@ std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, 
   }
   std::vector<cv::Mat> own;
   if (!distances) {
-    for (const cv::Mat& s : silhouettes) own.push_back(DistanceToSilhouette(s));
+    own = carver.DistanceTransforms(silhouettes);
     distances = &own;
   }
   std::optional<BodyPlacement> best;

@@ -76,14 +76,14 @@ struct VoxelHull {
   std::vector<Eigen::Vector3d> OccupiedCenters() const;
 };
 
-// Precomputes the voxel-to-pixel table for one rig and grid (thesis 4.2: "the
-// camera calibration parameters allow us to pre-compute a look-up table"), then
-// carves any number of silhouette sets with it.
 // Per pixel centre, the exact Euclidean distance in pixels to the nearest
 // pixel centre of `silhouette` (CV_8UC1, > 127 is silhouette), CV_32F and
 // continuous; 1e6 everywhere when the silhouette is empty.
 cv::Mat DistanceToSilhouette(const cv::Mat& silhouette);
 
+// Precomputes the voxel-to-pixel table for one rig and grid (thesis 4.2: "the
+// camera calibration parameters allow us to pre-compute a look-up table"), then
+// carves any number of silhouette sets with it.
 class VoxelCarver {
  public:
   // Throws InputError for bad options or no cameras. Cost: about two
@@ -109,6 +109,9 @@ class VoxelCarver {
   // mismatch. The blocks are carved in parallel; the result does not depend
   // on the thread count.
   VoxelHull CarveDistances(const std::vector<cv::Mat>& distances) const;
+  // DistanceToSilhouette of each camera's silhouette, as Carve takes them;
+  // throws InputError on a count or size mismatch.
+  std::vector<cv::Mat> DistanceTransforms(const std::vector<cv::Mat>& silhouettes) const;
 
   // The same occupancy by the plain evaluation of every candidate voxel in
   // every camera, without the block bounds: the reference for tests; slow.
@@ -147,8 +150,6 @@ class VoxelCarver {
     uint32_t first, count;
   };
 
-  // Distance transforms of the silhouettes (see Carve); throws InputError.
-  std::vector<cv::Mat> DistanceTransforms(const std::vector<cv::Mat>& silhouettes) const;
   VoxelHull EmptyHull() const;
 
   std::vector<Camera> cameras_;

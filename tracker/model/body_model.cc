@@ -36,6 +36,8 @@ const Vector3d kUp(0, 0, 1);
 
 double YawFacing(const Eigen::Vector2d& dir) { return std::atan2(-dir.x(), dir.y()); }
 
+Eigen::Vector2d FacingDirection(double yaw) { return {-std::sin(yaw), std::cos(yaw)}; }
+
 double WrapAngle(double a) {
   a = std::fmod(a + M_PI, 2 * M_PI);
   if (a < 0) a += 2 * M_PI;
@@ -264,9 +266,10 @@ bool ClampToJointLimits(BodyPose* pose) {
 
 BodyPose StandingPose(const BodyShape& shape, const Eigen::Vector2d& root_xy, double yaw) {
   BodyPose p;
-  // The waist stands ankle_setback_m ahead (+y of the body) of the root.
-  p.dof[kDofX] = root_xy.x() - shape.ankle_setback_m * std::sin(yaw);
-  p.dof[kDofY] = root_xy.y() + shape.ankle_setback_m * std::cos(yaw);
+  // The waist stands ankle_setback_m ahead of the root.
+  const Eigen::Vector2d waist_xy = root_xy + shape.ankle_setback_m * FacingDirection(yaw);
+  p.dof[kDofX] = waist_xy.x();
+  p.dof[kDofY] = waist_xy.y();
   p.dof[kDofZ] = shape.waist_height_m;
   p.dof[kDofYaw] = yaw;
   // Arms hang slightly away from the body.

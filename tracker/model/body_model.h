@@ -146,6 +146,8 @@ double WrapAngle(double a);
 // The body yaw (DOF 3) of a body facing the unit direction `dir` (world xy;
 // yaw 0 faces +y).
 double YawFacing(const Eigen::Vector2d& dir);
+// Its inverse: the unit direction (world xy) a body of yaw `yaw` faces.
+Eigen::Vector2d FacingDirection(double yaw);
 
 // ZXY Euler angles: Rz(z) * Rx(x) * Ry(y).
 Eigen::Matrix3d RotationZxy(double z, double x, double y);

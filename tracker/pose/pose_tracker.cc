@@ -409,17 +409,15 @@ BodyPose PoseTracker::Propose(const BodyPose& current, const BodyPose& previous,
     next.dof[kDofRightShoulderTwist] = next.dof[kDofLeftShoulderTwist] = 0.0;
   } else if (choice < options_.p_random_walk + options_.p_body_position) {
     // Body position (thesis 6.3.2): the x and y of a random 3D torso axis
-    // point (the trunk's middle, the waist spine_depth_m behind it), else the
-    // voxel hull's root; while the user walks, the heading from the hull's motion (people
-    // face where they walk).
+    // point (the trunk's middle, the waist spine_depth_m behind it), else
+    // the voxel hull's root; while the user walks, the heading from the
+    // hull's motion (people face where they walk).
     if (walking_) next.dof[kDofYaw] = YawFacing(velocity_xy_.normalized()) + 0.1 * n01(rng_);
     const Vector2d noise(0.02 * n01(rng_), 0.02 * n01(rng_));
     if (!torso_xy_.empty()) {
-      // The axis runs through the trunk's middle, the spine (the waist
-      // joint) spine_depth_m behind it.
       std::uniform_int_distribution<size_t> pick(0, torso_xy_.size() - 1);
-      const double yaw = next.dof[kDofYaw];
-      const Vector2d xy = torso_xy_[pick(rng_)] + noise - shape_.spine_depth_m * Vector2d(-std::sin(yaw), std::cos(yaw));
+      const Vector2d xy =
+          torso_xy_[pick(rng_)] + noise - shape_.spine_depth_m * FacingDirection(next.dof[kDofYaw]);
       next.dof[kDofX] = xy.x();
       next.dof[kDofY] = xy.y();
     } else {
