@@ -57,16 +57,20 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
       silhouette.rows != graph.height) {
     throw std::invalid_argument("SegmentBodyParts: the silhouette must be CV_8UC1 of the graph's size");
   }
-  // The person: the largest 8-connected blob. (connectedComponents and one
-  // pass for the areas and boxes: connectedComponentsWithStats takes several
-  // times longer in OpenCV 4.6.)
+  // The person: the largest 8-connected blob. Labelled within the
+  // silhouette's box (blob_id's pixel (0, 0) is the image's `sil_box.tl()`),
+  // with one pass for the areas and boxes (connectedComponentsWithStats takes
+  // several times longer in OpenCV 4.6).
+  const cv::Rect sil_box = cv::boundingRect(silhouette);
+  if (sil_box.empty()) return std::nullopt;
   cv::Mat1i blob_id;
-  const int count = cv::connectedComponents(silhouette > 0, blob_id, 8, CV_32S);
-  std::vector<int> area(count, 0), left(count, silhouette.cols), right(count, -1), top(count, -1), bottom(count, -1);
+  const int count = cv::connectedComponents(silhouette(sil_box) > 0, blob_id, 8, CV_32S);
+  std::vector<int> area(count, 0), left(count, blob_id.cols), right(count, -1), top(count, -1), bottom(count, -1);
   for (int y = 0; y < blob_id.rows; ++y) {
     const int* lp = blob_id[y];
     for (int x = 0; x < blob_id.cols; ++x) {
       const int c = lp[x];
+      if (c == 0) continue;
       ++area[c];
       left[c] = std::min(left[c], x);
       right[c] = std::max(right[c], x);
@@ -82,16 +86,20 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
     }
   }
   if (best == 0 || best_area < options.min_blob_area_px) return std::nullopt;
-  const int blob_bottom = bottom[best];
+  const int blob_bottom = sil_box.y + bottom[best];
 
   // Torso centre: the centre of the largest inscribed circle. The distance
   // transform runs on the blob's box with a ring of background around it:
   // the nearest background pixel of any blob pixel lies within, so the
   // values (and the first maximum, row by row) are those of the whole image.
-  const cv::Rect box = cv::Rect(left[best] - 1, top[best] - 1, right[best] - left[best] + 3,
+  // (Outside the silhouette's box all is background: the ring there is
+  // zeros.)
+  const cv::Rect box = cv::Rect(sil_box.x + left[best] - 1, sil_box.y + top[best] - 1, right[best] - left[best] + 3,
                                 bottom[best] - top[best] + 3) &
                        cv::Rect(0, 0, silhouette.cols, silhouette.rows);
-  const cv::Mat1b blob = blob_id(box) == best;
+  cv::Mat1b blob = cv::Mat1b::zeros(box.size());
+  const cv::Rect labelled = box & sil_box;
+  blob(labelled - box.tl()).setTo(255, blob_id(labelled - sil_box.tl()) == best);
   cv::Mat1f inside;
   cv::distanceTransform(blob, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   double radius = 0;
@@ -106,7 +114,7 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
   auto in_blob = [&](const AxisPoint2d& p) {
     const int u = std::clamp(int(std::floor(p.px.x())), 0, graph.width - 1);
     const int v = std::clamp(int(std::floor(p.px.y())), 0, graph.height - 1);
-    return blob_id(v, u) == best;
+    return sil_box.contains(cv::Point(u, v)) && blob_id(v - sil_box.y, u - sil_box.x) == best;
   };
   // Horizontal axis point of `row` whose run contains column u, or -1.
   std::map<int, std::vector<int>> horizontal_by_row;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <opencv2/core/utility.hpp>
@@ -112,27 +113,40 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
         ++observed[v];
     }
   }
-  // The candidates, grouped by block (counting sort on the block index; within
-  // a block in voxel index order).
+  // The candidates, grouped by block and, within a block, by sub-block
+  // (counting sort on the pair; within a sub-block in voxel index order).
   const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock,
             bz = (nz_ + kBlock - 1) / kBlock;
-  auto block_of = [&](size_t v) {
+  constexpr int kSub = kBlock / 2;
+  auto key_of = [&](size_t v) {
     const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
               z = static_cast<int>(v / nx_ / ny_);
-    return (size_t(z / kBlock) * by + y / kBlock) * bx + x / kBlock;
+    const size_t block = (size_t(z / kBlock) * by + y / kBlock) * bx + x / kBlock;
+    const int sub = ((z % kBlock) / kSub * 2 + (y % kBlock) / kSub) * 2 + (x % kBlock) / kSub;
+    return block * 8 + sub;
   };
-  std::vector<uint32_t> per_block(size_t(bx) * by * bz + 1, 0);
+  const size_t n_keys = size_t(bx) * by * bz * 8;
+  std::vector<uint32_t> per_block(n_keys + 1, 0);  // per key, then its start
   for (size_t v = 0; v < voxels; ++v) {
-    if (observed[v] >= options_.min_observing_cameras) ++per_block[block_of(v) + 1];
+    if (observed[v] >= options_.min_observing_cameras) ++per_block[key_of(v) + 1];
   }
-  for (size_t b = 1; b < per_block.size(); ++b) {
-    if (per_block[b] > 0) blocks_.push_back({per_block[b - 1], per_block[b]});
-    per_block[b] += per_block[b - 1];
+  size_t last_block = SIZE_MAX;
+  for (size_t key = 0; key < n_keys; ++key) {
+    const uint32_t count = per_block[key + 1];
+    per_block[key + 1] += per_block[key];
+    if (count == 0) continue;
+    if (key / 8 != last_block) {
+      last_block = key / 8;
+      blocks_.push_back({per_block[key], 0, static_cast<uint32_t>(sub_blocks_.size()), 0});
+    }
+    sub_blocks_.push_back({per_block[key], count, 0, 0});
+    blocks_.back().count += count;
+    ++blocks_.back().sub_count;
   }
   candidates_.resize(per_block.back());
   for (size_t v = 0; v < voxels; ++v) {
     if (observed[v] >= options_.min_observing_cameras)
-      candidates_[per_block[block_of(v)]++] = static_cast<uint32_t>(v);
+      candidates_[per_block[key_of(v)]++] = static_cast<uint32_t>(v);
   }
   per_block = {};
   observed = {};
@@ -203,49 +217,47 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
   // of the transform adds error far below kSlackPx.
   constexpr double kSlackPx = 0.01;
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  bounds_.resize(blocks_.size() * nc);
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    const Block& block = blocks_[b];
-    for (size_t c = 0; c < nc; ++c) {
-      const int w = cameras_[c].width, h = cameras_[c].height;
-      double u_lo = 1e30, u_hi = -1e30, v_lo = 1e30, v_hi = -1e30, r_lo = 1e30, r_hi = 0;
-      bool all_constrained = true;
-      for (uint32_t k = block.first; k < block.first + block.count; ++k) {
-        const Footprint& f = footprints_[size_t(k) * nc + c];
-        if (f.pixel < 0) {
-          all_constrained = false;
-          continue;
-        }
-        const double u = f.pixel % w + f.frac_u / 256.0, v = f.pixel / w + f.frac_v / 256.0;
-        u_lo = std::min(u_lo, u);
-        u_hi = std::max(u_hi, u);
-        v_lo = std::min(v_lo, v);
-        v_hi = std::max(v_hi, v);
-        r_lo = std::min(r_lo, f.radius_q / 64.0);
-        r_hi = std::max(r_hi, f.radius_q / 64.0);
-      }
-      BlockBound& bound = bounds_[b * nc + c];
-      if (u_lo > u_hi) {  // no voxel of the block is constrained: all pass
-        bound = {0, kInf, kInf};
+  auto bound_of = [&](const Block& block, size_t c) -> BlockBound {
+    const int w = cameras_[c].width, h = cameras_[c].height;
+    double u_lo = 1e30, u_hi = -1e30, v_lo = 1e30, v_hi = -1e30, r_lo = 1e30, r_hi = 0;
+    bool all_constrained = true;
+    for (uint32_t k = block.first; k < block.first + block.count; ++k) {
+      const Footprint& f = footprints_[size_t(k) * nc + c];
+      if (f.pixel < 0) {
+        all_constrained = false;
         continue;
       }
-      const double cu = 0.5 * (u_lo + u_hi), cv = 0.5 * (v_lo + v_hi);
-      const int gu = std::clamp(static_cast<int>(std::lround(cu)), 0, w - 1),
-                gv = std::clamp(static_cast<int>(std::lround(cv)), 0, h - 1);
-      double rho = 0;
-      for (uint32_t k = block.first; k < block.first + block.count; ++k) {
-        const Footprint& f = footprints_[size_t(k) * nc + c];
-        if (f.pixel < 0) continue;
-        rho = std::max(rho, std::hypot(f.pixel % w + f.frac_u / 256.0 - cu,
-                                       f.pixel / w + f.frac_v / 256.0 - cv));
-      }
-      const double reach = std::sqrt(2.0) + rho + std::hypot(cu - gu, cv - gv) + kSlackPx;
-      bound.pixel = gv * w + gu;
-      // Voxels without a constraint pass, so only a fully constrained block
-      // can be carved whole.
-      bound.carve_above = all_constrained ? static_cast<float>(r_hi + reach) : kInf;
-      bound.keep_below = static_cast<float>(r_lo - reach);
+      const double u = f.pixel % w + f.frac_u / 256.0, v = f.pixel / w + f.frac_v / 256.0;
+      u_lo = std::min(u_lo, u);
+      u_hi = std::max(u_hi, u);
+      v_lo = std::min(v_lo, v);
+      v_hi = std::max(v_hi, v);
+      r_lo = std::min(r_lo, f.radius_q / 64.0);
+      r_hi = std::max(r_hi, f.radius_q / 64.0);
     }
+    if (u_lo > u_hi) return {0, kInf, kInf};  // no voxel of the block is constrained: all pass
+    const double cu = 0.5 * (u_lo + u_hi), cv = 0.5 * (v_lo + v_hi);
+    const int gu = std::clamp(static_cast<int>(std::lround(cu)), 0, w - 1),
+              gv = std::clamp(static_cast<int>(std::lround(cv)), 0, h - 1);
+    double rho = 0;
+    for (uint32_t k = block.first; k < block.first + block.count; ++k) {
+      const Footprint& f = footprints_[size_t(k) * nc + c];
+      if (f.pixel < 0) continue;
+      rho = std::max(rho, std::hypot(f.pixel % w + f.frac_u / 256.0 - cu, f.pixel / w + f.frac_v / 256.0 - cv));
+    }
+    const double reach = std::sqrt(2.0) + rho + std::hypot(cu - gu, cv - gv) + kSlackPx;
+    // Voxels without a constraint pass, so only a fully constrained block
+    // can be carved whole.
+    return {gv * w + gu, all_constrained ? static_cast<float>(r_hi + reach) : kInf,
+            static_cast<float>(r_lo - reach)};
+  };
+  bounds_.resize(blocks_.size() * nc);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    for (size_t c = 0; c < nc; ++c) bounds_[b * nc + c] = bound_of(blocks_[b], c);
+  }
+  sub_bounds_.resize(sub_blocks_.size() * nc);
+  for (size_t b = 0; b < sub_blocks_.size(); ++b) {
+    for (size_t c = 0; c < nc; ++c) sub_bounds_[b * nc + c] = bound_of(sub_blocks_[b], c);
   }
 }
 
@@ -372,7 +384,7 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
                          std::to_string(distances.size()));
   }
   std::vector<const float*> dist(nc);
-  std::vector<int> width(nc);
+  std::vector<int> width(nc), all_cameras(nc);
   for (size_t c = 0; c < nc; ++c) {
     const cv::Mat& d = distances[c];
     if (d.type() != CV_32FC1 || d.cols != cameras_[c].width || d.rows != cameras_[c].height || !d.isContinuous()) {
@@ -381,6 +393,7 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
     }
     dist[c] = d.ptr<float>();
     width[c] = cameras_[c].width;
+    all_cameras[c] = static_cast<int>(c);
   }
   VoxelHull hull = EmptyHull();
   const int allowed = options_.max_missing_views;
@@ -388,42 +401,67 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
   // Blocks write disjoint voxels: ranges of them run in parallel.
   const int n_blocks = static_cast<int>(blocks_.size());
   cv::parallel_for_(cv::Range(0, n_blocks), [&](const cv::Range& range) {
-    std::vector<int> unsure(nc);  // the cameras to consult per voxel
+    std::vector<int> unsure(nc), sub_unsure(nc);  // the cameras to consult
     int count = 0;
-    for (int b = range.start; b < range.end; ++b) {
-      const BlockBound* bound = bounds_.data() + size_t(b) * nc;
-      int carved = 0, n_unsure = 0;
-      for (size_t c = 0; c < nc; ++c) {
+    // Judges the group [first, first + count) by its bounds: false when
+    // more than `allowed` cameras carve it all; otherwise `misses` is the
+    // count of those that do and `*n_left` that of the cameras in `left`
+    // still unsure of some of its voxels.
+    auto judge = [&](const BlockBound* bound, const int* cams, int n_cams, int* misses, int* left, int* n_left) {
+      *n_left = 0;
+      for (int i = 0; i < n_cams; ++i) {
+        const int c = cams[i];
         const float d = dist[c][bound[c].pixel];
         if (d > bound[c].carve_above) {
-          ++carved;
+          ++*misses;
         } else if (!(d <= bound[c].keep_below)) {
-          unsure[n_unsure++] = static_cast<int>(c);
+          left[(*n_left)++] = c;
         }
       }
-      if (carved > allowed) continue;
+      return *misses <= allowed;
+    };
+    for (int b = range.start; b < range.end; ++b) {
+      int carved = 0, n_unsure = 0;
+      if (!judge(bounds_.data() + size_t(b) * nc, all_cameras.data(), nc, &carved, unsure.data(), &n_unsure)) {
+        continue;
+      }
       const Block& block = blocks_[b];
-      const uint32_t end = block.first + block.count;
       if (n_unsure == 0) {
-        for (uint32_t k = block.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+        for (uint32_t k = block.first; k < block.first + block.count; ++k) hull.occupied[candidates_[k]] = 1;
         count += static_cast<int>(block.count);
         continue;
       }
-      for (uint32_t k = block.first; k < end; ++k) {
-        const Footprint* fp = footprints_.data() + size_t(k) * nc;
-        int misses = carved;
-        for (int i = 0; i < n_unsure && misses <= allowed; ++i) {
-          const int c = unsure[i];
-          misses += !Passes(dist[c], width[c], fp[c]);
+      // The block's sub-blocks, by their own (tighter) bounds, in the
+      // cameras still unsure.
+      for (uint32_t s = block.sub_first; s < block.sub_first + block.sub_count; ++s) {
+        int sub_carved = carved, n_sub_unsure = 0;
+        if (!judge(sub_bounds_.data() + size_t(s) * nc, unsure.data(), n_unsure, &sub_carved, sub_unsure.data(),
+                   &n_sub_unsure)) {
+          continue;
         }
-        if (misses <= allowed) {
-          hull.occupied[candidates_[k]] = 1;
-          ++count;
+        const Block& sub = sub_blocks_[s];
+        const uint32_t end = sub.first + sub.count;
+        if (n_sub_unsure == 0) {
+          for (uint32_t k = sub.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+          count += static_cast<int>(sub.count);
+          continue;
+        }
+        for (uint32_t k = sub.first; k < end; ++k) {
+          const Footprint* fp = footprints_.data() + size_t(k) * nc;
+          int misses = sub_carved;
+          for (int i = 0; i < n_sub_unsure && misses <= allowed; ++i) {
+            const int c = sub_unsure[i];
+            misses += !Passes(dist[c], width[c], fp[c]);
+          }
+          if (misses <= allowed) {
+            hull.occupied[candidates_[k]] = 1;
+            ++count;
+          }
         }
       }
     }
     occupied += count;
-  }, 8);
+  }, 64);
   hull.occupied_count = occupied;
   return hull;
 }

@@ -99,8 +99,10 @@ class VoxelCarver {
   // values of all the block's voxels from the distance transform at one pixel
   // (the transform is 1-Lipschitz). A block that more than max_missing_views
   // cameras certainly carve is skipped; a camera that certainly keeps a block
-  // is not consulted for its voxels; only the rest go through the per-voxel
-  // test. The result is bit-identical to CarveReference().
+  // is not consulted for its voxels. A block some camera is unsure of is
+  // judged again, in those cameras, by its octants' bounds (sub-blocks of
+  // (kBlock/2)^3 voxels); only the rest go through the per-voxel test. The
+  // result is bit-identical to CarveReference().
   VoxelHull Carve(const std::vector<cv::Mat>& silhouettes) const;
 
   // The same from the silhouettes' distance transforms (DistanceToSilhouette
@@ -145,9 +147,12 @@ class VoxelCarver {
     int32_t pixel;
     float carve_above, keep_below;
   };
-  // The candidates [first, first + count) in candidates_ form one block.
+  // The candidates [first, first + count) in candidates_ form one block
+  // (or sub-block); a block's sub-blocks are sub_blocks_[sub_first, sub_first
+  // + sub_count).
   struct Block {
     uint32_t first, count;
+    uint32_t sub_first, sub_count;
   };
 
   VoxelHull EmptyHull() const;
@@ -159,6 +164,8 @@ class VoxelCarver {
   std::vector<Footprint> footprints_;   // candidate-major: [candidate][camera]
   std::vector<Block> blocks_;           // the blocks holding candidates
   std::vector<BlockBound> bounds_;      // [block][camera]
+  std::vector<Block> sub_blocks_;       // the blocks' octants holding candidates
+  std::vector<BlockBound> sub_bounds_;  // [sub-block][camera]
 };
 
 }  // namespace irbench

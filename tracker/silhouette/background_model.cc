@@ -202,11 +202,6 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   r.screen_gain = EstimateScreenGain(frame);
   const cv::Mat z = Normalised(frame, static_cast<float>(r.light_level), static_cast<float>(r.screen_gain));
   r.raw = cv::abs(z) > options_.threshold_sigma;
-  {
-    cv::Mat smooth;
-    cv::GaussianBlur(z, smooth, cv::Size(), 1.5 * frame.cols / 320.0);
-    r.darker = smooth < 0;
-  }
   if (options_.model == "flicker" && options_.pool_sigma > 0) {
     cv::Mat pooled;
     cv::GaussianBlur(z, pooled, cv::Size(), PoolSigmaPx(frame.cols));
@@ -215,34 +210,44 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
     // threshold or strong (thresholds in float, as cv::compare takes them).
     const float strong_above = static_cast<float>(options_.pool_threshold * pooled_noise_);
     const float weak_above = static_cast<float>(options_.pool_weak_threshold * pooled_noise_);
-    cv::Mat strong(pooled.size(), CV_8U), weak(pooled.size(), CV_8U);
-    for (int y = 0; y < pooled.rows; ++y) {
+    // The weak pixels 8-connected to a strong one, by a flood from the strong
+    // ones (the same as labelling the weak mask's components and keeping
+    // those holding a strong pixel, at a fraction of the cost: the region is
+    // small against the image). `weak` has a one-pixel border of zeros, so
+    // no neighbour needs a bounds check.
+    const int w = pooled.cols, h = pooled.rows, stride = w + 2;
+    cv::Mat weak = cv::Mat::zeros(h + 2, stride, CV_8U);
+    cv::Mat grown = cv::Mat::zeros(h, w, CV_8U);
+    thread_local std::vector<int> stack;
+    stack.clear();
+    for (int y = 0; y < h; ++y) {
       const float* pp = pooled.ptr<float>(y);
       const uint8_t* rp = r.raw.ptr<uint8_t>(y);
-      uint8_t* sp = strong.ptr<uint8_t>(y);
-      uint8_t* wp = weak.ptr<uint8_t>(y);
-      for (int x = 0; x < pooled.cols; ++x) {
+      uint8_t* wp = weak.ptr<uint8_t>(y + 1) + 1;
+      uint8_t* gp = grown.ptr<uint8_t>(y);
+      for (int x = 0; x < w; ++x) {
         const float a = std::abs(pp[x]);
-        sp[x] = a > strong_above || rp[x] ? 255 : 0;
-        wp[x] = a > weak_above || sp[x] ? 255 : 0;
+        if (a > strong_above || rp[x]) {
+          gp[x] = 255;
+          stack.push_back((y + 1) * stride + x + 1);
+        } else if (a > weak_above) {
+          wp[x] = 255;  // weak and not yet reached
+        }
       }
     }
-    cv::Mat labels;
-    const int count = cv::connectedComponents(weak, labels, 8, CV_32S);
-    std::vector<uint8_t> keep(count, 0);
-    for (int y = 0; y < labels.rows; ++y) {
-      const int* lp = labels.ptr<int>(y);
-      const uint8_t* sp = strong.ptr<uint8_t>(y);
-      for (int x = 0; x < labels.cols; ++x) {
-        if (sp[x]) keep[lp[x]] = 1;
+    uint8_t* weak_at = weak.data;
+    const int offsets[8] = {-stride - 1, -stride, -stride + 1, -1, 1, stride - 1, stride, stride + 1};
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      for (const int o : offsets) {
+        const int j = i + o;
+        if (weak_at[j]) {
+          weak_at[j] = 0;
+          grown.at<uint8_t>(j / stride - 1, j % stride - 1) = 255;
+          stack.push_back(j);
+        }
       }
-    }
-    keep[0] = 0;
-    cv::Mat grown(labels.size(), CV_8U);
-    for (int y = 0; y < labels.rows; ++y) {
-      const int* lp = labels.ptr<int>(y);
-      uint8_t* out = grown.ptr<uint8_t>(y);
-      for (int x = 0; x < labels.cols; ++x) out[x] = keep[lp[x]] ? 255 : 0;
     }
     // Pooling spreads a region by about the window's radius: take it back.
     const int r_px = std::max(1, static_cast<int>(std::lround(PoolSigmaPx(frame.cols))));
@@ -256,6 +261,16 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
                               static_cast<int>(options_.min_blob_fraction * frame.total()),
                               static_cast<int>(std::lround(options_.near_blob_px * scale)),
                               static_cast<int>(options_.near_blob_min_fraction * frame.total()));
+  // Darker than the stage, smoothed: within the mask's box only, where shadow
+  // removal reads it. A blur of the box as a view of z reads z's pixels
+  // around it, so the values are those of the whole image's blur.
+  r.darker = cv::Mat::zeros(frame.size(), CV_8U);
+  const cv::Rect box = cv::boundingRect(r.mask);
+  if (!box.empty()) {
+    cv::Mat smooth;
+    cv::GaussianBlur(z(box), smooth, cv::Size(), 1.5 * frame.cols / 320.0);
+    r.darker(box).setTo(255, smooth < 0);
+  }
   return r;
 }
 
@@ -284,20 +299,38 @@ int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, in
     candidate[i] = near_px > 0 && !keep[i] && area[i] >= near_min_area;
   }
   if (std::find(candidate.begin(), candidate.end(), 1) != candidate.end()) {
-    // Those touching the kept blobs grown by near_px stay (the grown mask is
-    // made before any is kept, so a kept one does not reach further).
-    cv::Mat near(mask.size(), CV_8U);
-    for (int y = 0; y < mask.rows; ++y) {
+    // Those touching the kept blobs grown by near_px stay (judged against the
+    // blobs kept by area only, so a kept one does not reach further). The
+    // kernel is symmetric: a kept pixel lies within it about a candidate's
+    // pixel exactly when the candidate grown by it touches a kept pixel, and
+    // growing each (small) candidate in its own box is far cheaper than
+    // growing the kept blobs over the whole image.
+    std::vector<cv::Rect> box(count);
+    for (int y = 0; y < labels.rows; ++y) {
       const int* lp = labels.ptr<int>(y);
-      uint8_t* np = near.ptr<uint8_t>(y);
-      for (int x = 0; x < mask.cols; ++x) np[x] = keep[lp[x]] ? 255 : 0;
+      for (int x = 0; x < labels.cols; ++x) {
+        if (candidate[lp[x]]) box[lp[x]] |= cv::Rect(x, y, 1, 1);
+      }
     }
-    cv::dilate(near, near, kernel(near_px));
-    for (int y = 0; y < mask.rows; ++y) {
-      const int* lp = labels.ptr<int>(y);
-      const uint8_t* np = near.ptr<uint8_t>(y);
-      for (int x = 0; x < mask.cols; ++x) {
-        if (np[x] && candidate[lp[x]]) keep[lp[x]] = 1;
+    const std::vector<uint8_t> kept_by_area = keep;
+    const cv::Mat grow = kernel(near_px);
+    for (int i = 1; i < count; ++i) {
+      if (!candidate[i]) continue;
+      const cv::Rect roi = cv::Rect(box[i].x - near_px, box[i].y - near_px, box[i].width + 2 * near_px,
+                                    box[i].height + 2 * near_px) &
+                           cv::Rect(0, 0, mask.cols, mask.rows);
+      const cv::Mat local_labels = labels(roi);
+      cv::Mat blob = local_labels == i;
+      cv::dilate(blob, blob, grow);
+      for (int y = 0; y < roi.height && !keep[i]; ++y) {
+        const int* lp = local_labels.ptr<int>(y);
+        const uint8_t* bp = blob.ptr<uint8_t>(y);
+        for (int x = 0; x < roi.width; ++x) {
+          if (bp[x] && kept_by_area[lp[x]]) {
+            keep[i] = 1;
+            break;
+          }
+        }
       }
     }
   }
