@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace irbench {
 namespace {
@@ -161,10 +163,18 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
     return count;
   };
 
-  std::vector<AxisPoint3d> raw;
   const double min_epipolar_sin = std::sin(options.min_epipolar_angle_deg * kDegToRad);
+  // Every pair of views, in parallel; the points are gathered in pair order,
+  // so the result does not depend on the thread count.
+  std::vector<std::pair<size_t, size_t>> pairs;
   for (size_t i = 0; i < views.size(); ++i) {
-    for (size_t j = i + 1; j < views.size(); ++j) {
+    for (size_t j = i + 1; j < views.size(); ++j) pairs.emplace_back(i, j);
+  }
+  std::vector<std::vector<AxisPoint3d>> per_pair(pairs.size());
+  cv::parallel_for_(cv::Range(0, int(pairs.size())), [&](const cv::Range& r) {
+    for (int pair = r.start; pair < r.end; ++pair) {
+      const auto [i, j] = pairs[pair];
+      std::vector<AxisPoint3d>& found = per_pair[pair];
       const PreparedView& vi = prepared[i];
       const PreparedView& vj = prepared[j];
       // Essential matrix mapping normalised points of i to epipolar lines of j.
@@ -222,25 +232,55 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
               point.camera_a = int(i);
               point.camera_b = int(j);
               point.support = count;
-              raw.push_back(point);
+              found.push_back(point);
             }
           }
         }
       }
     }
-  }
+  });
+  std::vector<AxisPoint3d> raw;
+  for (const std::vector<AxisPoint3d>& found : per_pair) raw.insert(raw.end(), found.begin(), found.end());
   if (options.merge_radius_m <= 0) return raw;
 
-  // Greedy merge of one part's points within merge_radius_m of a seed.
+  // Greedy merge of one part's points within merge_radius_m of a seed, in
+  // index order. The points are binned in cubes of that edge: those within
+  // the radius of a seed lie in the 27 cubes about its own, and taken in
+  // index order they give the plain scan's sums.
   std::vector<AxisPoint3d> merged;
   std::vector<bool> used(raw.size(), false);
   const double radius2 = options.merge_radius_m * options.merge_radius_m;
+  auto cell_of = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3i(int(std::floor(p.x() / options.merge_radius_m)),
+                           int(std::floor(p.y() / options.merge_radius_m)),
+                           int(std::floor(p.z() / options.merge_radius_m)));
+  };
+  auto key_of = [](const Eigen::Vector3i& c) {
+    return (int64_t(c.x()) * 2097152 + c.y()) * 2097152 + c.z();
+  };
+  std::unordered_map<int64_t, std::vector<size_t>> cells;
+  for (size_t k = 0; k < raw.size(); ++k) cells[key_of(cell_of(raw[k].p_in_world))].push_back(k);
+  std::vector<size_t> near;
   for (size_t s = 0; s < raw.size(); ++s) {
     if (used[s]) continue;
     AxisPoint3d sum = raw[s];
     sum.merged = 1;
     used[s] = true;
-    for (size_t k = s + 1; k < raw.size(); ++k) {
+    near.clear();
+    const Eigen::Vector3i c = cell_of(raw[s].p_in_world);
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = cells.find(key_of(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells.end()) continue;
+          for (size_t k : it->second) {
+            if (k > s) near.push_back(k);
+          }
+        }
+      }
+    }
+    std::sort(near.begin(), near.end());
+    for (size_t k : near) {
       if (used[k] || raw[k].part != raw[s].part) continue;
       if ((raw[k].p_in_world - raw[s].p_in_world).squaredNorm() > radius2) continue;
       used[k] = true;
@@ -254,6 +294,18 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
     merged.push_back(sum);
   }
   return merged;
+}
+
+AxisView MakeAxisView(const Camera& camera, const cv::Mat& silhouette, const BodyAxesOptions& options) {
+  AxisView view;
+  view.camera = camera;
+  view.silhouette = silhouette;
+  view.graph = ExtractAxisPoints(silhouette, options.points);
+  const Eigen::Vector3d optical_axis_in_world = camera.cam_from_world.linear().transpose().col(2);
+  const double elevation_deg = std::asin(std::clamp(optical_axis_in_world.z(), -1.0, 1.0)) / kDegToRad;
+  if (std::abs(elevation_deg) > options.max_view_elevation_deg) return view;
+  if (auto parts = SegmentBodyParts(silhouette, view.graph, options.parts)) view.labels = std::move(parts->labels);
+  return view;
 }
 
 std::vector<AxisPoint3d> ReconstructBodyAxes(const std::vector<Camera>& cameras,
@@ -278,16 +330,8 @@ std::vector<AxisPoint3d> ReconstructBodyAxes(const std::vector<Camera>& cameras,
   std::vector<AxisView> views(cameras.size());
   cv::parallel_for_(cv::Range(0, int(cameras.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
-      views[i].camera = cameras[i];
-      views[i].silhouette = silhouettes[i];
+      views[i] = MakeAxisView(cameras[i], silhouettes[i], options);
       if (distances) views[i].distance_to_silhouette = (*distances)[i];
-      views[i].graph = ExtractAxisPoints(silhouettes[i], options.points);
-      const Eigen::Vector3d optical_axis_in_world = cameras[i].cam_from_world.linear().transpose().col(2);
-      const double elevation_deg = std::asin(std::clamp(optical_axis_in_world.z(), -1.0, 1.0)) / kDegToRad;
-      if (std::abs(elevation_deg) > options.max_view_elevation_deg) continue;
-      if (auto parts = SegmentBodyParts(silhouettes[i], views[i].graph, options.parts)) {
-        views[i].labels = std::move(parts->labels);
-      }
     }
   });
   std::vector<AxisPoint3d> points = ReconstructAxis3d(views, options.axis3d);

@@ -80,6 +80,12 @@ struct BodyAxesOptions {
   void Check() const;  // throws std::invalid_argument
 };
 
+// One camera's 2D stages: its axis graph (3.2) and, unless the camera looks
+// more steeply than options.max_view_elevation_deg, its body parts (3.3).
+// `silhouette` is CV_8UC1 of the camera's size (not checked here); the view
+// keeps it. distance_to_silhouette is left to the caller.
+AxisView MakeAxisView(const Camera& camera, const cv::Mat& silhouette, const BodyAxesOptions& options);
+
 // The whole chain for one frame: 2D axis points (3.2), body parts (3.3) and 3D
 // axis points (4.4.2). `silhouettes[i]` is CV_8UC1 of `cameras[i]`'s size.
 // `views_out`, when given, receives each camera's 2D axis graph and part labels.

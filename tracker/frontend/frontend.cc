@@ -1,5 +1,6 @@
 #include "tracker/frontend/frontend.h"
 
+#include <array>
 #include <chrono>
 #include <functional>
 #include <opencv2/core/utility.hpp>
@@ -147,49 +148,72 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
       for (int c = r.start; c < r.end; ++c) f(c);
     });
   };
+  // The per-camera stages (silhouette, shadows, distance transform, 2D axes
+  // and parts, polygons) run as one task per camera: one hand-over between
+  // the threads instead of one per stage. The wall time of this part is
+  // shared among its stages in proportion to the time each took on its
+  // thread, so the stage times still add up to the front end's.
   auto t = std::chrono::steady_clock::now();
   FrameFeatures out;
   out.frame = frame;
   out.cameras.resize(nc);
+  out.polygons.resize(nc);
+  const bool need_distances = options_.find_axes || carver_;
+  std::vector<cv::Mat> silhouettes(nc), distances(need_distances ? nc : 0);
+  std::vector<AxisView> views(options_.find_axes ? nc : 0);
+  // Per camera, ms on its thread: silhouettes, axes, polygons, voxels.
+  std::vector<std::array<double, 4>> thread_ms(nc, {0, 0, 0, 0});
   per_camera([&](int c) {
+    auto tc = std::chrono::steady_clock::now();
     const SilhouetteResult r = background_[c].Segment(frames[c]);
     CameraFeatures& cf = out.cameras[c];
     cf.before_shadows = r.mask;
     cf.silhouette = options_.remove_shadows ? shadows_[c].Remove(frames[c], r.mask, r.darker) : r.mask;
     cf.light_level = r.light_level;
     cf.blobs_removed = r.blobs_removed;
+    silhouettes[c] = cf.silhouette;
+    thread_ms[c][0] = since(tc);
+    // The distance transform serves the 3D axes' silhouette test and the
+    // voxel carving; it counts with the first of them that runs.
+    tc = std::chrono::steady_clock::now();
+    if (need_distances) distances[c] = DistanceToSilhouette(silhouettes[c]);
+    if (options_.find_axes) views[c] = MakeAxisView(cameras_[c], silhouettes[c], options_.axes);
+    thread_ms[c][options_.find_axes ? 1 : 3] = since(tc);
+    tc = std::chrono::steady_clock::now();
+    out.polygons[c] = ApproximateSilhouette(silhouettes[c], options_.polygons);
+    thread_ms[c][2] = since(tc);
   });
-  out.ms_silhouettes = since(t);
-  std::vector<cv::Mat> silhouettes;
-  for (const CameraFeatures& cf : out.cameras) silhouettes.push_back(cf.silhouette);
-  // Each silhouette's distance transform, for the 3D axes' silhouette test
-  // and the voxel carving: made in the first stage that needs it.
-  std::vector<cv::Mat> distances;
-  auto make_distances = [&] {
-    if (!distances.empty()) return;
-    distances.resize(nc);
-    per_camera([&](int c) { distances[c] = DistanceToSilhouette(silhouettes[c]); });
-  };
+  {
+    const double wall = since(t);
+    std::array<double, 4> sum = {0, 0, 0, 0};
+    for (const auto& ms : thread_ms) {
+      for (int s = 0; s < 4; ++s) sum[s] += ms[s];
+    }
+    const double total = sum[0] + sum[1] + sum[2] + sum[3];
+    const double share = total > 0 ? wall / total : 0;
+    out.ms_silhouettes = sum[0] * share;
+    out.ms_axes = sum[1] * share;
+    out.ms_polygons = sum[2] * share;
+    out.ms_voxels = sum[3] * share;
+  }
   if (options_.find_axes) {
     t = std::chrono::steady_clock::now();
-    make_distances();
-    out.axis3d = ReconstructBodyAxes(cameras_, silhouettes, options_.axes, &out.views, &distances);
-    out.ms_axes = since(t);
+    for (int c = 0; c < nc; ++c) views[c].distance_to_silhouette = distances[c];
+    out.axis3d = ReconstructAxis3d(views, options_.axes.axis3d);
+    // The distance maps stay with the front end (four floats a pixel).
+    for (AxisView& view : views) view.distance_to_silhouette.release();
+    out.views = std::move(views);
+    out.ms_axes += since(t);
   }
-  t = std::chrono::steady_clock::now();
-  out.polygons.resize(nc);
-  per_camera([&](int c) { out.polygons[c] = ApproximateSilhouette(silhouettes[c], options_.polygons); });
-  out.ms_polygons = since(t);
   if (carver_) {
     t = std::chrono::steady_clock::now();
-    make_distances();
     out.voxels = carver_->CarveDistances(distances);
     out.placement = PlaceBody(*out.voxels);
     if (!out.placement && options_.placement_drop_view && silhouettes.size() >= 4 &&
         options_.voxels.max_missing_views == 0) {
       out.placement = PlaceBodyWithoutOneView(*carver_, silhouettes, options_.placement_max_coverage, &distances);
     }
-    out.ms_voxels = since(t);
+    out.ms_voxels += since(t);
   }
   if (options_.polyhedral_hull) {
     t = std::chrono::steady_clock::now();

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -56,24 +58,27 @@ double VoxelHull::VolumeM3() const {
 std::vector<Eigen::Vector3d> VoxelHull::OccupiedCenters() const {
   std::vector<Eigen::Vector3d> out;
   out.reserve(occupied_count);
-  // In index order (z, then y, then x), skipping empty runs 8 voxels at a time.
-  const size_t n = occupied.size();
+  // In index order (z, then y, then x), each row's run within the box
+  // skipping empty voxels 8 at a time.
+  const std::array<int, 6> box = occupied_within.value_or(std::array<int, 6>{0, 0, 0, nx, ny, nz});
   const uint8_t* o = occupied.data();
-  for (size_t i = 0; i < n;) {
-    if (i + 8 <= n) {
-      uint64_t word;
-      std::memcpy(&word, o + i, 8);
-      if (word == 0) {
-        i += 8;
-        continue;
+  for (int z = std::max(0, box[2]); z < std::min(nz, box[5]); ++z) {
+    for (int y = std::max(0, box[1]); y < std::min(ny, box[4]); ++y) {
+      const size_t row = (size_t(z) * ny + y) * nx;
+      const int end = std::min(nx, box[3]);
+      for (int x = std::max(0, box[0]); x < end;) {
+        if (x + 8 <= end) {
+          uint64_t word;
+          std::memcpy(&word, o + row + x, 8);
+          if (word == 0) {
+            x += 8;
+            continue;
+          }
+        }
+        if (o[row + x]) out.push_back(VoxelCenter(x, y, z));
+        ++x;
       }
     }
-    if (o[i]) {
-      const int x = static_cast<int>(i % nx), y = static_cast<int>((i / nx) % ny),
-                z = static_cast<int>(i / nx / ny);
-      out.push_back(VoxelCenter(x, y, z));
-    }
-    ++i;
   }
   return out;
 }
@@ -137,9 +142,10 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
     if (count == 0) continue;
     if (key / 8 != last_block) {
       last_block = key / 8;
-      blocks_.push_back({per_block[key], 0, static_cast<uint32_t>(sub_blocks_.size()), 0});
+      blocks_.push_back(
+          {per_block[key], 0, static_cast<uint32_t>(sub_blocks_.size()), 0, static_cast<uint32_t>(last_block)});
     }
-    sub_blocks_.push_back({per_block[key], count, 0, 0});
+    sub_blocks_.push_back({per_block[key], count, 0, 0, 0});
     blocks_.back().count += count;
     ++blocks_.back().sub_count;
   }
@@ -400,9 +406,15 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
   std::atomic<int> occupied{0};
   // Blocks write disjoint voxels: ranges of them run in parallel.
   const int n_blocks = static_cast<int>(blocks_.size());
+  // The box of the blocks holding occupied voxels, in blocks: {x0, y0, z0,
+  // x1, y1, z1}, inclusive.
+  const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock;
+  std::array<int, 6> block_box = {INT_MAX, INT_MAX, INT_MAX, -1, -1, -1};
+  std::mutex box_mutex;
   cv::parallel_for_(cv::Range(0, n_blocks), [&](const cv::Range& range) {
     std::vector<int> unsure(nc), sub_unsure(nc);  // the cameras to consult
     int count = 0;
+    std::array<int, 6> box = {INT_MAX, INT_MAX, INT_MAX, -1, -1, -1};
     // Judges the group [first, first + count) by its bounds: false when
     // more than `allowed` cameras carve it all; otherwise `misses` is the
     // count of those that do and `*n_left` that of the cameras in `left`
@@ -421,6 +433,17 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
       return *misses <= allowed;
     };
     for (int b = range.start; b < range.end; ++b) {
+      const int count_before = count;
+      // Widens the box by block b when it got occupied voxels.
+      const auto widen = [&] {
+        if (count == count_before) return;
+        const uint32_t index = blocks_[b].index;
+        const int at[3] = {int(index % bx), int(index / bx % by), int(index / bx / by)};
+        for (int a = 0; a < 3; ++a) {
+          box[a] = std::min(box[a], at[a]);
+          box[a + 3] = std::max(box[a + 3], at[a]);
+        }
+      };
       int carved = 0, n_unsure = 0;
       if (!judge(bounds_.data() + size_t(b) * nc, all_cameras.data(), nc, &carved, unsure.data(), &n_unsure)) {
         continue;
@@ -429,6 +452,7 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
       if (n_unsure == 0) {
         for (uint32_t k = block.first; k < block.first + block.count; ++k) hull.occupied[candidates_[k]] = 1;
         count += static_cast<int>(block.count);
+        widen();
         continue;
       }
       // The block's sub-blocks, by their own (tighter) bounds, in the
@@ -459,10 +483,24 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
           }
         }
       }
+      widen();
     }
     occupied += count;
+    std::lock_guard<std::mutex> lock(box_mutex);
+    for (int a = 0; a < 3; ++a) {
+      block_box[a] = std::min(block_box[a], box[a]);
+      block_box[a + 3] = std::max(block_box[a + 3], box[a + 3]);
+    }
   }, 64);
   hull.occupied_count = occupied;
+  if (block_box[3] < 0) {
+    hull.occupied_within = std::array<int, 6>{0, 0, 0, 0, 0, 0};
+  } else {
+    hull.occupied_within = std::array<int, 6>{block_box[0] * kBlock, block_box[1] * kBlock, block_box[2] * kBlock,
+                                              std::min(nx_, (block_box[3] + 1) * kBlock),
+                                              std::min(ny_, (block_box[4] + 1) * kBlock),
+                                              std::min(nz_, (block_box[5] + 1) * kBlock)};
+  }
   return hull;
 }
 

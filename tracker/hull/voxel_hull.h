@@ -18,8 +18,10 @@
 // constraint on the voxel.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "sim/camera/camera.h"
@@ -64,6 +66,10 @@ struct VoxelHull {
   int nx = 0, ny = 0, nz = 0;
   std::vector<uint8_t> occupied;  // 0/1, index (z * ny + y) * nx + x
   int occupied_count = 0;
+  // When set, every occupied voxel lies within this box of voxel indices,
+  // {x0, y0, z0, x1, y1, z1}, each range [lo, hi): a bound the carver knows
+  // from its blocks, so that OccupiedCenters need not read the whole grid.
+  std::optional<std::array<int, 6>> occupied_within;
 
   size_t Index(int x, int y, int z) const { return (size_t(z) * ny + y) * nx + x; }
   bool Occupied(int x, int y, int z) const { return occupied[Index(x, y, z)] != 0; }
@@ -153,6 +159,7 @@ class VoxelCarver {
   struct Block {
     uint32_t first, count;
     uint32_t sub_first, sub_count;
+    uint32_t index;  // (bz * by + by) * bx + bx in the grid of blocks (blocks only)
   };
 
   VoxelHull EmptyHull() const;

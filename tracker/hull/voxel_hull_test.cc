@@ -298,7 +298,8 @@ TEST(VoxelHullTest, CoarseToFineEqualsThePerVoxelReference) {
       int counted = 0;
       for (uint8_t o : fast.occupied) counted += o;
       EXPECT_EQ(counted, fast.occupied_count);
-      // OccupiedCenters skips empty runs: the same centres, in index order.
+      // OccupiedCenters reads only the carver's box and skips empty runs:
+      // the same centres, in index order.
       std::vector<Eigen::Vector3d> centres;
       for (int z = 0; z < fast.nz; ++z) {
         for (int y = 0; y < fast.ny; ++y) {
