@@ -11,6 +11,46 @@ namespace {
 constexpr int kMinLightPixels = 50;
 }  // namespace
 
+// By way of a sample: the sample's quantiles about k bracket the value, one
+// pass counts and gathers the values between them, and only those are
+// selected from. When the bracket misses (rarely: it spans many standard
+// errors of the sample quantile), the whole vector is selected from.
+float ValueOfRank(std::vector<float>& v, size_t k) {
+  const size_t n = v.size();
+  constexpr size_t kStep = 8;
+  if (n < 64 * kStep) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+  }
+  thread_local std::vector<float> sample, between;
+  sample.clear();
+  for (size_t i = 0; i < n; i += kStep) sample.push_back(v[i]);
+  const size_t m = sample.size();
+  const size_t at = k * m / n, margin = 4 * static_cast<size_t>(std::sqrt(double(m))) + 2;
+  const size_t lo_rank = at > margin ? at - margin : 0, hi_rank = std::min(m - 1, at + margin);
+  std::nth_element(sample.begin(), sample.begin() + static_cast<std::ptrdiff_t>(hi_rank), sample.end());
+  const float hi = sample[hi_rank];
+  std::nth_element(sample.begin(), sample.begin() + static_cast<std::ptrdiff_t>(lo_rank),
+                   sample.begin() + static_cast<std::ptrdiff_t>(hi_rank));
+  const float lo = sample[lo_rank];
+  // Branch-free: the values fall either side of the bracket at random.
+  size_t below = 0, count = 0;
+  between.resize(n);
+  for (const float x : v) {
+    below += x < lo;
+    between[count] = x;
+    count += (x >= lo) & (x <= hi);
+  }
+  between.resize(count);
+  if (k >= below && k < below + between.size()) {
+    const auto target = between.begin() + static_cast<std::ptrdiff_t>(k - below);
+    std::nth_element(between.begin(), target, between.end());
+    return *target;
+  }
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
 void BackgroundOptions::Check() const {
   if (model != "flicker" && model != "plain") {
     throw std::invalid_argument("background model: must be flicker or plain, not '" + model + "'");
@@ -117,6 +157,14 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     dof = fit(false);
   }
   m.light_pixel_count_ = cv::countNonZero(m.light_pixels_);
+  // The light is read from every other row and column: a quarter of the
+  // pixels is plenty for a median.
+  for (int y = 0; y < size.height; y += 2) {
+    const uint8_t* lp = m.light_pixels_.ptr<uint8_t>(y);
+    for (int x = 0; x < size.width; x += 2) {
+      if (lp[x]) m.light_samples_.push_back({y, x});
+    }
+  }
   // The pooled difference's noise, measured where it is used.
   if (flicker && options.pool_sigma > 0) {
     double sum_sq = 0;
@@ -178,21 +226,13 @@ cv::Mat BackgroundModel::Expected(double light) const {
 double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
   if (light_pixel_count_ < kMinLightPixels) return mean_light_;
   thread_local std::vector<float> estimates;
-  estimates.clear();
-  // Every other row and column: a quarter of the pixels is plenty for a median.
-  for (int y = 0; y < frame.rows; y += 2) {
-    const uint8_t* ip = frame.ptr<uint8_t>(y);
-    const uint8_t* lp = light_pixels_.ptr<uint8_t>(y);
-    const float* ap = a_.ptr<float>(y);
-    const float* bp = b_.ptr<float>(y);
-    for (int x = 0; x < frame.cols; x += 2) {
-      if (lp[x]) estimates.push_back((ip[x] - ap[x]) / bp[x]);
-    }
+  estimates.resize(light_samples_.size());
+  for (size_t i = 0; i < light_samples_.size(); ++i) {
+    const auto [y, x] = light_samples_[i];
+    estimates[i] = (frame.ptr<uint8_t>(y)[x] - a_.ptr<float>(y)[x]) / b_.ptr<float>(y)[x];
   }
   if (estimates.empty()) return mean_light_;
-  auto mid = estimates.begin() + static_cast<std::ptrdiff_t>(estimates.size() / 2);
-  std::nth_element(estimates.begin(), mid, estimates.end());
-  return *mid;
+  return ValueOfRank(estimates, estimates.size() / 2);
 }
 
 SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {

@@ -22,6 +22,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace irbench {
@@ -99,11 +100,17 @@ class BackgroundModel {
 
   cv::Mat light_pixels_;  // CV_8U: pixels whose b is large enough to read L from
   int light_pixel_count_ = 0;
+  std::vector<std::pair<int, int>> light_samples_;  // (y, x): the light pixels on even rows and columns
   cv::Mat screen_;        // CV_8U: screen pixels (may be empty)
   cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;
   double pooled_noise_ = 1;  // std of the pooled z on the training frames
 };
+
+// The value of rank `k` (< v.size()) in `v`: what std::nth_element puts at
+// v[k], found faster for large v (the light estimate's median). `v` is
+// reordered.
+float ValueOfRank(std::vector<float>& v, size_t k);
 
 // Opening then closing with elliptical kernels of the given radii, then
 // removal of 8-connected blobs smaller than `min_area` pixels, except those of

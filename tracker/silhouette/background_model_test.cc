@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <vector>
 
 namespace irbench {
 namespace {
@@ -199,6 +201,33 @@ TEST(BackgroundModelTest, NoisyTrainingStillFollowsAFlash) {
   }
   EXPECT_GT(levels[1], levels[0] + 3);  // the flash is followed
   EXPECT_LT(levels[2], levels[0] - 3);
+}
+
+// The light estimate's median by way of a sample: the value std::nth_element
+// finds, for sizes either side of the sampling threshold, ties, skewed values
+// and input whose sample lies (every 8th value far off: the bracket misses and
+// the whole vector is searched).
+TEST(BackgroundModelTest, ValueOfRankIsNthElements) {
+  std::mt19937 rng(11);
+  std::normal_distribution<float> normal(40.0f, 3.0f);
+  std::exponential_distribution<float> skewed(0.2f);
+  std::uniform_int_distribution<int> few(0, 5);
+  for (const size_t n : {1, 7, 511, 512, 4000, 19200}) {
+    for (int kind = 0; kind < 4; ++kind) {
+      std::vector<float> v(n);
+      for (size_t i = 0; i < n; ++i) {
+        v[i] = kind == 0   ? normal(rng)
+               : kind == 1 ? skewed(rng)
+               : kind == 2 ? static_cast<float>(few(rng))
+                           : (i % 8 == 0 ? 1000.0f + i : normal(rng));
+      }
+      for (const size_t k : {size_t(0), n / 2, n - 1}) {
+        std::vector<float> expected = v, ours = v;
+        std::nth_element(expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(k), expected.end());
+        EXPECT_EQ(ValueOfRank(ours, k), expected[k]) << "n " << n << " kind " << kind << " k " << k;
+      }
+    }
+  }
 }
 
 }  // namespace
