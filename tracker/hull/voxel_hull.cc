@@ -321,14 +321,20 @@ cv::Mat DistanceToSilhouette(const cv::Mat& silhouette) {
       z[k] = s;
       z[k + 1] = std::numeric_limits<double>::infinity();
     }
+    // The squared distances (integers, exact in float); their roots below,
+    // all at once.
+    // Parabola j holds the columns x with z[j] < x <= z[j + 1].
     float* op = out.ptr<float>(y);
-    k = 0;
-    for (int x = 0; x < w; ++x) {
-      while (z[k + 1] < x) ++k;
-      const int dx = x - v[k], gy = g[v[k]];
-      op[x] = std::sqrt(static_cast<float>(dx * dx + gy * gy));
+    int x = 0;
+    for (int j = 0; j <= k && x < w; ++j) {
+      const int last = z[j + 1] >= w - 1 ? w - 1 : static_cast<int>(std::floor(z[j + 1]));
+      const int q = v[j], gy2 = g[q] * g[q];
+      for (; x <= last; ++x) op[x] = static_cast<float>((x - q) * (x - q) + gy2);
     }
   }
+  // cv::sqrt runs vectorised; IEEE square roots are correctly rounded, so
+  // the values are those of std::sqrt per pixel.
+  cv::sqrt(out, out);
   return out;
 }
 
