@@ -122,32 +122,40 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
   // (counting sort on the pair; within a sub-block in voxel index order).
   const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock,
             bz = (nz_ + kBlock - 1) / kBlock;
-  constexpr int kSub = kBlock / 2;
+  // Keys: block, then its octant (sub-block), then the octant's octant (cell).
+  constexpr int kSub = kBlock / 2, kCell = kBlock / 4;
   auto key_of = [&](size_t v) {
     const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
               z = static_cast<int>(v / nx_ / ny_);
     const size_t block = (size_t(z / kBlock) * by + y / kBlock) * bx + x / kBlock;
     const int sub = ((z % kBlock) / kSub * 2 + (y % kBlock) / kSub) * 2 + (x % kBlock) / kSub;
-    return block * 8 + sub;
+    const int cell = ((z % kSub) / kCell * 2 + (y % kSub) / kCell) * 2 + (x % kSub) / kCell;
+    return (block * 8 + sub) * 8 + cell;
   };
-  const size_t n_keys = size_t(bx) * by * bz * 8;
+  const size_t n_keys = size_t(bx) * by * bz * 64;
   std::vector<uint32_t> per_block(n_keys + 1, 0);  // per key, then its start
   for (size_t v = 0; v < voxels; ++v) {
     if (observed[v] >= options_.min_observing_cameras) ++per_block[key_of(v) + 1];
   }
-  size_t last_block = SIZE_MAX;
+  size_t last_block = SIZE_MAX, last_sub = SIZE_MAX;
   for (size_t key = 0; key < n_keys; ++key) {
     const uint32_t count = per_block[key + 1];
     per_block[key + 1] += per_block[key];
     if (count == 0) continue;
-    if (key / 8 != last_block) {
-      last_block = key / 8;
+    if (key / 64 != last_block) {
+      last_block = key / 64;
       blocks_.push_back(
           {per_block[key], 0, static_cast<uint32_t>(sub_blocks_.size()), 0, static_cast<uint32_t>(last_block)});
     }
-    sub_blocks_.push_back({per_block[key], count, 0, 0, 0});
+    if (key / 8 != last_sub) {
+      last_sub = key / 8;
+      sub_blocks_.push_back({per_block[key], 0, static_cast<uint32_t>(cells_.size()), 0, 0});
+      ++blocks_.back().sub_count;
+    }
+    cells_.push_back({per_block[key], count, 0, 0, 0});
+    ++sub_blocks_.back().sub_count;
+    sub_blocks_.back().count += count;
     blocks_.back().count += count;
-    ++blocks_.back().sub_count;
   }
   candidates_.resize(per_block.back());
   for (size_t v = 0; v < voxels; ++v) {
@@ -264,6 +272,10 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
   sub_bounds_.resize(sub_blocks_.size() * nc);
   for (size_t b = 0; b < sub_blocks_.size(); ++b) {
     for (size_t c = 0; c < nc; ++c) sub_bounds_[b * nc + c] = bound_of(sub_blocks_[b], c);
+  }
+  cell_bounds_.resize(cells_.size() * nc);
+  for (size_t b = 0; b < cells_.size(); ++b) {
+    for (size_t c = 0; c < nc; ++c) cell_bounds_[b * nc + c] = bound_of(cells_[b], c);
   }
 }
 
@@ -418,7 +430,7 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
   std::array<int, 6> block_box = {INT_MAX, INT_MAX, INT_MAX, -1, -1, -1};
   std::mutex box_mutex;
   cv::parallel_for_(cv::Range(0, n_blocks), [&](const cv::Range& range) {
-    std::vector<int> unsure(nc), sub_unsure(nc);  // the cameras to consult
+    std::vector<int> unsure(nc), sub_unsure(nc), cell_unsure(nc);  // the cameras to consult
     int count = 0;
     std::array<int, 6> box = {INT_MAX, INT_MAX, INT_MAX, -1, -1, -1};
     // Judges the group [first, first + count) by its bounds: false when
@@ -470,22 +482,36 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
           continue;
         }
         const Block& sub = sub_blocks_[s];
-        const uint32_t end = sub.first + sub.count;
         if (n_sub_unsure == 0) {
-          for (uint32_t k = sub.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+          for (uint32_t k = sub.first; k < sub.first + sub.count; ++k) hull.occupied[candidates_[k]] = 1;
           count += static_cast<int>(sub.count);
           continue;
         }
-        for (uint32_t k = sub.first; k < end; ++k) {
-          const Footprint* fp = footprints_.data() + size_t(k) * nc;
-          int misses = sub_carved;
-          for (int i = 0; i < n_sub_unsure && misses <= allowed; ++i) {
-            const int c = sub_unsure[i];
-            misses += !Passes(dist[c], width[c], fp[c]);
+        // Its cells (2x2x2 voxels) likewise, then their voxels.
+        for (uint32_t e = sub.sub_first; e < sub.sub_first + sub.sub_count; ++e) {
+          int cell_carved = sub_carved, n_cell_unsure = 0;
+          if (!judge(cell_bounds_.data() + size_t(e) * nc, sub_unsure.data(), n_sub_unsure, &cell_carved,
+                     cell_unsure.data(), &n_cell_unsure)) {
+            continue;
           }
-          if (misses <= allowed) {
-            hull.occupied[candidates_[k]] = 1;
-            ++count;
+          const Block& cell = cells_[e];
+          const uint32_t end = cell.first + cell.count;
+          if (n_cell_unsure == 0) {
+            for (uint32_t k = cell.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+            count += static_cast<int>(cell.count);
+            continue;
+          }
+          for (uint32_t k = cell.first; k < end; ++k) {
+            const Footprint* fp = footprints_.data() + size_t(k) * nc;
+            int misses = cell_carved;
+            for (int i = 0; i < n_cell_unsure && misses <= allowed; ++i) {
+              const int c = cell_unsure[i];
+              misses += !Passes(dist[c], width[c], fp[c]);
+            }
+            if (misses <= allowed) {
+              hull.occupied[candidates_[k]] = 1;
+              ++count;
+            }
           }
         }
       }

@@ -107,8 +107,9 @@ class VoxelCarver {
   // cameras certainly carve is skipped; a camera that certainly keeps a block
   // is not consulted for its voxels. A block some camera is unsure of is
   // judged again, in those cameras, by its octants' bounds (sub-blocks of
-  // (kBlock/2)^3 voxels); only the rest go through the per-voxel test. The
-  // result is bit-identical to CarveReference().
+  // (kBlock/2)^3 voxels), and those by theirs (cells of 2^3); only the rest
+  // go through the per-voxel test. The result is bit-identical to
+  // CarveReference().
   VoxelHull Carve(const std::vector<cv::Mat>& silhouettes) const;
 
   // The same from the silhouettes' distance transforms (DistanceToSilhouette
@@ -134,7 +135,7 @@ class VoxelCarver {
   size_t candidate_count() const { return candidates_.size(); }
 
  private:
-  // Edge of a block, in voxels.
+  // Edge of a block, in voxels (a sub-block's is half, a cell's a quarter).
   static constexpr int kBlock = 8;
 
   // Per candidate voxel and camera: the index of the pixel at the floor of the
@@ -154,8 +155,8 @@ class VoxelCarver {
     float carve_above, keep_below;
   };
   // The candidates [first, first + count) in candidates_ form one block
-  // (or sub-block); a block's sub-blocks are sub_blocks_[sub_first, sub_first
-  // + sub_count).
+  // (or sub-block, or cell); a block's sub-blocks are sub_blocks_[sub_first,
+  // sub_first + sub_count), and a sub-block's cells cells_[the same].
   struct Block {
     uint32_t first, count;
     uint32_t sub_first, sub_count;
@@ -173,6 +174,8 @@ class VoxelCarver {
   std::vector<BlockBound> bounds_;      // [block][camera]
   std::vector<Block> sub_blocks_;       // the blocks' octants holding candidates
   std::vector<BlockBound> sub_bounds_;  // [sub-block][camera]
+  std::vector<Block> cells_;            // the sub-blocks' octants (2x2x2 voxels) holding candidates
+  std::vector<BlockBound> cell_bounds_;  // [cell][camera]
 };
 
 }  // namespace irbench
