@@ -112,17 +112,17 @@ AxisGraph ExtractAxisPoints(const cv::Mat& silhouette, const AxisPointOptions& o
   graph.height = silhouette.rows;
   const int w = graph.width, h = graph.height;
 
-  // Run length (pixels, diagonals scaled) through every foreground pixel, per direction.
+  // Only the silhouette's box holds runs: each line is scanned across it.
+  const cv::Rect box = cv::boundingRect(silhouette);
+  // Run length (pixels, diagonals scaled) through every foreground pixel, per
+  // direction; over the box (pixel p at p - box.tl()).
   std::array<cv::Mat1f, kScanDirectionCount> run_length;
   // Per direction and line: indices of its axis points in increasing t.
   std::array<std::vector<std::vector<int>>, kScanDirectionCount> by_line;
-
-  // Only the silhouette's box holds runs: each line is scanned across it.
-  const cv::Rect box = cv::boundingRect(silhouette);
   for (int d = 0; d < kScanDirectionCount; ++d) {
     const ScanLines lines{ScanDirection(d), w, h};
     const double step_len = lines.StepVector().norm();
-    run_length[d] = cv::Mat1f(h, w, 0.0f);
+    run_length[d] = cv::Mat1f(box.height, box.width, 0.0f);
     by_line[d].resize(lines.Count());
     if (box.empty()) continue;
     for (int k = 0; k < lines.Count(); ++k) {
@@ -138,7 +138,7 @@ AxisGraph ExtractAxisPoints(const cv::Mat& silhouette, const AxisPointOptions& o
         while (t <= t_end && silhouette.at<uint8_t>(lines.Pixel(k, t))) ++t;
         const int t1 = t - 1;
         const double length = (t1 - t0 + 1) * step_len;
-        for (int s = t0; s <= t1; ++s) run_length[d](lines.Pixel(k, s)) = float(length);
+        for (int s = t0; s <= t1; ++s) run_length[d](lines.Pixel(k, s) - box.tl()) = float(length);
         if (t1 - t0 + 1 < options.min_run_px) continue;
         AxisPoint2d point;
         point.px = lines.PixelAt(k, 0.5 * (t0 + t1));
@@ -182,7 +182,7 @@ AxisGraph ExtractAxisPoints(const cv::Mat& silhouette, const AxisPointOptions& o
     const cv::Point mid = lines.Pixel(point.line, (point.t0 + point.t1) / 2);
     float shortest_other = std::numeric_limits<float>::infinity();
     for (int e = 0; e < kScanDirectionCount; ++e) {
-      if (e != d) shortest_other = std::min(shortest_other, run_length[e](mid));
+      if (e != d) shortest_other = std::min(shortest_other, run_length[e](mid - box.tl()));
     }
     point.kept = point.run_px <= (1 + options.keep_slack) * shortest_other;
 

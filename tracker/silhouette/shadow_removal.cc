@@ -82,7 +82,8 @@ cv::Mat ShadowRemover::Remove(const cv::Mat& frame, const cv::Mat& silhouette, c
   KeepEnclosed(silhouette(roi), edges, options_.min_directions,
                static_cast<int>(std::lround(options_.edge_reach * scale)))
       .copyTo(kept(roi));
-  if (!darker.empty()) kept.setTo(255, silhouette & ~darker);
+  // (The silhouette lies within the box: the rest of the image is left alone.)
+  if (!darker.empty()) kept(roi).setTo(255, silhouette(roi) & ~darker(roi));
   return kept;
 }
 
