@@ -93,7 +93,10 @@ struct FrameFeatures {
   std::optional<VoxelHull> voxels;
   std::optional<HullMesh> hull;  // the polyhedral hull (not watertight)
   std::optional<BodyPlacement> placement;  // nullopt: the stage looks empty
-  double ms_silhouettes = 0;  // wall time of each stage for all cameras
+  // Wall time of each stage for all cameras. The per-camera stages run as
+  // one task per camera; their share of that part's wall time is their share
+  // of the time on the threads, so the stages add up to the front end's.
+  double ms_silhouettes = 0;
   double ms_axes = 0;
   double ms_polygons = 0;
   double ms_voxels = 0;
