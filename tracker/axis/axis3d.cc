@@ -250,10 +250,13 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
   std::vector<AxisPoint3d> merged;
   std::vector<bool> used(raw.size(), false);
   const double radius2 = options.merge_radius_m * options.merge_radius_m;
+  // Cubes a little larger than the radius (the divisions round on their own)
+  // and at least a millimetre; indices clamped so the keys cannot overflow
+  // (points clamped together share a cube, which only adds candidates).
+  const double cube = std::max(options.merge_radius_m, 1e-3) * (1 + 1e-6);
   auto cell_of = [&](const Eigen::Vector3d& p) {
-    return Eigen::Vector3i(int(std::floor(p.x() / options.merge_radius_m)),
-                           int(std::floor(p.y() / options.merge_radius_m)),
-                           int(std::floor(p.z() / options.merge_radius_m)));
+    auto index = [&](double u) { return int(std::clamp(std::floor(u / cube), -1048575.0, 1048575.0)); };
+    return Eigen::Vector3i(index(p.x()), index(p.y()), index(p.z()));
   };
   auto key_of = [](const Eigen::Vector3i& c) {
     return (int64_t(c.x()) * 2097152 + c.y()) * 2097152 + c.z();

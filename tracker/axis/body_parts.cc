@@ -61,8 +61,15 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
   // silhouette's box (blob_id's pixel (0, 0) is the image's `sil_box.tl()`),
   // with one pass for the areas and boxes (connectedComponentsWithStats takes
   // several times longer in OpenCV 4.6).
-  const cv::Rect sil_box = cv::boundingRect(silhouette);
+  cv::Rect sil_box = cv::boundingRect(silhouette);
   if (sil_box.empty()) return std::nullopt;
+  // OpenCV labels in 2x2 blocks from the image's corner: a box on even rows
+  // and columns keeps the blocks, so the blobs are labelled in the whole
+  // image's order (which breaks ties between equal areas below).
+  sil_box.width += sil_box.x & 1;
+  sil_box.x &= ~1;
+  sil_box.height += sil_box.y & 1;
+  sil_box.y &= ~1;
   cv::Mat1i blob_id;
   const int count = cv::connectedComponents(silhouette(sil_box) > 0, blob_id, 8, CV_32S);
   std::vector<int> area(count, 0), left(count, blob_id.cols), right(count, -1), top(count, -1), bottom(count, -1);

@@ -118,8 +118,8 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
         ++observed[v];
     }
   }
-  // The candidates, grouped by block and, within a block, by sub-block
-  // (counting sort on the pair; within a sub-block in voxel index order).
+  // The candidates, grouped by block, within it by sub-block and within that
+  // by cell (counting sort on the triple; within a cell in voxel index order).
   const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock,
             bz = (nz_ + kBlock - 1) / kBlock;
   // Keys: block, then its octant (sub-block), then the octant's octant (cell).

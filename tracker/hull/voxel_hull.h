@@ -94,7 +94,9 @@ class VoxelCarver {
  public:
   // Throws InputError for bad options or no cameras. Cost: about two
   // projections per voxel and camera (0.6 s for 4 cameras and 2.5 cm voxels);
-  // memory: 8 bytes per candidate voxel and camera plus 4 per candidate.
+  // memory: 8 bytes per candidate voxel and camera plus 4 per candidate, and
+  // the bounds of the blocks, sub-blocks and cells (about 2.5 + 1.5 per camera
+  // bytes per candidate).
   VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& options = {});
 
   // `silhouettes[c]`: CV_8UC1 of camera c's size, > 127 is silhouette.
@@ -160,7 +162,7 @@ class VoxelCarver {
   struct Block {
     uint32_t first, count;
     uint32_t sub_first, sub_count;
-    uint32_t index;  // (bz * by + by) * bx + bx in the grid of blocks (blocks only)
+    uint32_t index;  // (z_block * by + y_block) * bx + x_block in the grid of blocks (blocks only)
   };
 
   VoxelHull EmptyHull() const;

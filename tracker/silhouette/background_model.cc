@@ -301,12 +301,16 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
                               static_cast<int>(options_.min_blob_fraction * frame.total()),
                               static_cast<int>(std::lround(options_.near_blob_px * scale)),
                               static_cast<int>(options_.near_blob_min_fraction * frame.total()));
-  // Darker than the stage, smoothed: within the mask's box only, where shadow
-  // removal reads it. A blur of the box as a view of z reads z's pixels
-  // around it, so the values are those of the whole image's blur.
+  // Darker than the stage, smoothed: within the mask's rows only, where
+  // shadow removal reads it. A blur of a view of z reads z's pixels around
+  // it, so the values are those of the whole image's blur; the view starts
+  // at a multiple of 64 columns and runs to the right edge, so each pixel
+  // takes the same vectorised path (and rounding) as in the whole image.
   r.darker = cv::Mat::zeros(frame.size(), CV_8U);
-  const cv::Rect box = cv::boundingRect(r.mask);
+  cv::Rect box = cv::boundingRect(r.mask);
   if (!box.empty()) {
+    box.x &= ~63;
+    box.width = frame.cols - box.x;
     cv::Mat smooth;
     cv::GaussianBlur(z(box), smooth, cv::Size(), 1.5 * frame.cols / 320.0);
     r.darker(box).setTo(255, smooth < 0);

@@ -56,7 +56,7 @@ struct SilhouetteResult {
   cv::Mat mask;            // CV_8UC1, 255 foreground
   cv::Mat raw;             // before morphology and blob removal
   cv::Mat darker;          // 255 where the frame is darker than the expected stage (smoothed),
-                           // within `mask`'s bounding box (0 outside: shadow removal reads no more)
+                           // within `mask`'s rows (0 elsewhere: shadow removal reads no more)
   double light_level = 0;  // L(t) (flicker model); the training mean for "plain"
   double screen_gain = 1;  // the screen pixels' brightness relative to training
   int blobs_removed = 0;

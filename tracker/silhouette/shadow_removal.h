@@ -39,8 +39,9 @@ class ShadowRemover {
   // silhouette dilated by the reach.
   cv::Mat SegmentedEdges(const cv::Mat& frame, const cv::Mat& silhouette) const;
   // The silhouette with the shadow pixels removed. A shadow only darkens: when
-  // `darker` (255 where the frame is darker than the empty stage) is given,
-  // silhouette pixels outside it are body whatever the edges say.
+  // `darker` (255 where the frame is darker than the empty stage; read only
+  // within the silhouette's box) is given, silhouette pixels outside it are
+  // body whatever the edges say.
   cv::Mat Remove(const cv::Mat& frame, const cv::Mat& silhouette, const cv::Mat& darker = cv::Mat()) const;
 
   const cv::Mat& background_edges() const { return background_edges_; }
