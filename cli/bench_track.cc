@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <opencv2/core/utility.hpp>
 
 #include "common/logging.h"
 #include "tracker/frontend/frontend.h"
@@ -54,6 +55,20 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
       if (r == 0) all_features.push_back(std::move(features));
     }
   }
+  // The same on one thread: how much the cores add (the front end's work
+  // divided among them), and a figure less moved by a busy machine.
+  std::vector<double> one_thread;
+  {
+    const int threads = cv::getNumThreads();
+    cv::setNumThreads(1);
+    for (int r = 0; r < repeats; ++r) {
+      for (int f = 0; f < input.frame_count(); ++f) {
+        const FrameFeatures features = front_end.Process(f, images[f]);
+        one_thread.push_back(features.ms_silhouettes + features.ms_axes + features.ms_polygons + features.ms_voxels);
+      }
+    }
+    cv::setNumThreads(threads);
+  }
   auto row = [](const std::string& stage, std::vector<double> v) {
     std::sort(v.begin(), v.end());
     double sum = 0;
@@ -65,6 +80,7 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
       row("2D axis points, body parts, 3D axis points", axes), row("silhouette polygons", polygons),
       row("voxel hull (2 cm, look-up table)", voxels), row("polyhedral hull (on request)", polyhedral),
       row("front end as irbench track runs it (the stages above but the polyhedral hull)", tracked),
+      row("the same on one thread", one_thread),
       row("front end, all stages (polyhedral hull included)", total)};
   // The pose tracker (thesis 6.3) against particle count, on the same
   // features; frame-sets where it tracks.
