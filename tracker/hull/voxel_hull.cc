@@ -429,93 +429,70 @@ VoxelHull VoxelCarver::CarveDistances(const std::vector<cv::Mat>& distances) con
   const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock;
   std::array<int, 6> block_box = {INT_MAX, INT_MAX, INT_MAX, -1, -1, -1};
   std::mutex box_mutex;
+  // The levels of groups, coarse to fine: blocks, their octants (sub-blocks),
+  // and those octants' octants (cells of 2x2x2 voxels).
+  const std::array<const std::vector<Block>*, 3> groups = {&blocks_, &sub_blocks_, &cells_};
+  const std::array<const std::vector<BlockBound>*, 3> group_bounds = {&bounds_, &sub_bounds_, &cell_bounds_};
   cv::parallel_for_(cv::Range(0, n_blocks), [&](const cv::Range& range) {
-    std::vector<int> unsure(nc), sub_unsure(nc), cell_unsure(nc);  // the cameras to consult
+    std::array<std::vector<int>, 3> unsure;  // per level, the cameras still to consult
+    for (std::vector<int>& u : unsure) u.resize(nc);
     int count = 0;
     std::array<int, 6> box = {INT_MAX, INT_MAX, INT_MAX, -1, -1, -1};
-    // Judges the group [first, first + count) by its bounds: false when
-    // more than `allowed` cameras carve it all; otherwise `misses` is the
-    // count of those that do and `*n_left` that of the cameras in `left`
-    // still unsure of some of its voxels.
-    auto judge = [&](const BlockBound* bound, const int* cams, int n_cams, int* misses, int* left, int* n_left) {
-      *n_left = 0;
+    // Group g of `level`, in the cameras `cams` (the coarser level's unsure
+    // ones; `misses` already carve it): skipped when more than `allowed`
+    // cameras carve it all by its bounds, filled when none is unsure of it,
+    // else its finer groups (or, for a cell, its voxels) judged the same way.
+    auto visit = [&](auto& self, int level, uint32_t g, const int* cams, int n_cams, int misses) -> void {
+      const BlockBound* bound = group_bounds[level]->data() + size_t(g) * nc;
+      int* left = unsure[level].data();
+      int n_left = 0;
       for (int i = 0; i < n_cams; ++i) {
         const int c = cams[i];
         const float d = dist[c][bound[c].pixel];
         if (d > bound[c].carve_above) {
-          ++*misses;
+          ++misses;
         } else if (!(d <= bound[c].keep_below)) {
-          left[(*n_left)++] = c;
+          left[n_left++] = c;
         }
       }
-      return *misses <= allowed;
+      if (misses > allowed) return;
+      const Block& group = (*groups[level])[g];
+      const uint32_t end = group.first + group.count;
+      if (n_left == 0) {
+        for (uint32_t k = group.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
+        count += static_cast<int>(group.count);
+        return;
+      }
+      if (level + 1 < static_cast<int>(groups.size())) {
+        for (uint32_t s = group.sub_first; s < group.sub_first + group.sub_count; ++s) {
+          self(self, level + 1, s, left, n_left, misses);
+        }
+        return;
+      }
+      for (uint32_t k = group.first; k < end; ++k) {
+        const Footprint* fp = footprints_.data() + size_t(k) * nc;
+        int voxel_misses = misses;
+        for (int i = 0; i < n_left && voxel_misses <= allowed; ++i) {
+          const int c = left[i];
+          voxel_misses += !Passes(dist[c], width[c], fp[c]);
+        }
+        if (voxel_misses <= allowed) {
+          hull.occupied[candidates_[k]] = 1;
+          ++count;
+        }
+      }
     };
     for (int b = range.start; b < range.end; ++b) {
       const int count_before = count;
-      // Widens the box by block b when it got occupied voxels.
-      const auto widen = [&] {
-        if (count == count_before) return;
-        const uint32_t index = blocks_[b].index;
-        const int at[3] = {int(index % bx), int(index / bx % by), int(index / bx / by)};
-        for (int a = 0; a < 3; ++a) {
-          box[a] = std::min(box[a], at[a]);
-          box[a + 3] = std::max(box[a + 3], at[a]);
-        }
-      };
-      int carved = 0, n_unsure = 0;
-      if (!judge(bounds_.data() + size_t(b) * nc, all_cameras.data(), nc, &carved, unsure.data(), &n_unsure)) {
-        continue;
+      visit(visit, 0, static_cast<uint32_t>(b), all_cameras.data(), static_cast<int>(nc), 0);
+      if (count == count_before) continue;
+      // Block b got occupied voxels: it widens the box.
+      const uint32_t index = blocks_[b].index;
+      const int at[3] = {int(index % bx), int(index / bx % by), int(index / bx / by)};
+      for (int a = 0; a < 3; ++a) {
+        box[a] = std::min(box[a], at[a]);
+        box[a + 3] = std::max(box[a + 3], at[a]);
       }
-      const Block& block = blocks_[b];
-      if (n_unsure == 0) {
-        for (uint32_t k = block.first; k < block.first + block.count; ++k) hull.occupied[candidates_[k]] = 1;
-        count += static_cast<int>(block.count);
-        widen();
-        continue;
-      }
-      // The block's sub-blocks, by their own (tighter) bounds, in the
-      // cameras still unsure.
-      for (uint32_t s = block.sub_first; s < block.sub_first + block.sub_count; ++s) {
-        int sub_carved = carved, n_sub_unsure = 0;
-        if (!judge(sub_bounds_.data() + size_t(s) * nc, unsure.data(), n_unsure, &sub_carved, sub_unsure.data(),
-                   &n_sub_unsure)) {
-          continue;
-        }
-        const Block& sub = sub_blocks_[s];
-        if (n_sub_unsure == 0) {
-          for (uint32_t k = sub.first; k < sub.first + sub.count; ++k) hull.occupied[candidates_[k]] = 1;
-          count += static_cast<int>(sub.count);
-          continue;
-        }
-        // Its cells (2x2x2 voxels) likewise, then their voxels.
-        for (uint32_t e = sub.sub_first; e < sub.sub_first + sub.sub_count; ++e) {
-          int cell_carved = sub_carved, n_cell_unsure = 0;
-          if (!judge(cell_bounds_.data() + size_t(e) * nc, sub_unsure.data(), n_sub_unsure, &cell_carved,
-                     cell_unsure.data(), &n_cell_unsure)) {
-            continue;
-          }
-          const Block& cell = cells_[e];
-          const uint32_t end = cell.first + cell.count;
-          if (n_cell_unsure == 0) {
-            for (uint32_t k = cell.first; k < end; ++k) hull.occupied[candidates_[k]] = 1;
-            count += static_cast<int>(cell.count);
-            continue;
-          }
-          for (uint32_t k = cell.first; k < end; ++k) {
-            const Footprint* fp = footprints_.data() + size_t(k) * nc;
-            int misses = cell_carved;
-            for (int i = 0; i < n_cell_unsure && misses <= allowed; ++i) {
-              const int c = cell_unsure[i];
-              misses += !Passes(dist[c], width[c], fp[c]);
-            }
-            if (misses <= allowed) {
-              hull.occupied[candidates_[k]] = 1;
-              ++count;
-            }
-          }
-        }
-      }
-      widen();
     }
     occupied += count;
     std::lock_guard<std::mutex> lock(box_mutex);
