@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <memory>
 #include <opencv2/core/utility.hpp>
 
 #include "common/logging.h"
@@ -84,20 +85,31 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
       row("the same on one thread", one_thread),
       row("front end, all stages (polyhedral hull included)", total)};
   // The pose tracker (thesis 6.3) against particle count, on the same
-  // features; frame-sets where it tracks.
+  // features; frame-sets where it tracks. With the shipped rest-state
+  // classifier, as irbench track runs it, where the data root has it.
+  std::shared_ptr<const RestClassifier> rest;
+  if (fs::exists(DefaultRestModelPath())) {
+    rest = std::make_shared<const RestClassifier>(RestClassifier::Load(DefaultRestModelPath()));
+  } else {
+    Log().warn("bench track: no rest-state model at {}; the pose rows leave the rest state out",
+               DefaultRestModelPath().string());
+  }
   for (int particles : {25, 50, 100, 200, 400}) {
     std::vector<double> pose_ms;
     for (int r = 0; r < repeats; ++r) {
       PoseTrackerOptions pose_options;
       pose_options.particles = particles;
       PoseTracker tracker(input.cameras(), input.screens(), pose_options);
+      if (rest) tracker.set_rest_classifier(rest);
       for (const FrameFeatures& features : all_features) {
         const PoseEstimate e = tracker.Step(features, 1.0 / input.fps());
         if (e.tracking) pose_ms.push_back(e.ms_total);
       }
     }
     if (pose_ms.empty()) continue;
-    TrackBenchRow pose_row = row("pose tracker, " + std::to_string(particles) + " particles (20% refined by ICP)", pose_ms);
+    TrackBenchRow pose_row = row("pose tracker, " + std::to_string(particles) + " particles (20% refined by ICP" +
+                                     (rest ? ", rest state" : "") + ")",
+                                 pose_ms);
     rows.push_back(pose_row);
   }
   return rows;

@@ -193,11 +193,12 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   EXPECT_LT(Mean(errors["root"]), 0.045);
   ASSERT_GT(pointing_deg.size(), 30u);
   EXPECT_LT(Mean(pointing_deg), 3.5);
-  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.6 % (the
-  // SVM alone, without the likelihood-ratio test: 90.8 % before the spine
-  // offset).
+  // Issue 7's bar is 98.95 %. Measured here, seeds 1-3 pooled: 98.7 %
+  // (98.6 % before an arm the axis points show was judged by their angle;
+  // the SVM alone, without the likelihood-ratio test: 90.8 % before the
+  // spine offset).
   EXPECT_GT(rest_total, 1000);
-  EXPECT_GT(rest_accuracy, 0.96);
+  EXPECT_GT(rest_accuracy, 0.98);
 }
 
 // Thesis 6.6 reports recovery in 2-3 frames after a loss: scatter the

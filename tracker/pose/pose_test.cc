@@ -113,7 +113,10 @@ TEST(Icp, PullsAPerturbedArmAndBodyBackTowardsTheOutlines) {
 
 // Synthetic frame features from the model itself: silhouettes, the hull's
 // placement and 3D arm axis points along the true arms.
-FrameFeatures ModelFeatures(const std::vector<Camera>& cams, const BodyShape& shape, const BodyPose& truth, int frame) {
+// `arms`: which arms' 3D axis points the front end reports (right, left); a
+// real front end misses an arm held against the torso.
+FrameFeatures ModelFeatures(const std::vector<Camera>& cams, const BodyShape& shape, const BodyPose& truth, int frame,
+                            std::array<bool, 2> arms = {true, true}) {
   FrameFeatures f;
   f.frame = frame;
   const PosedBody body = PoseBody(shape, truth);
@@ -128,6 +131,7 @@ FrameFeatures ModelFeatures(const std::vector<Camera>& cams, const BodyShape& sh
   place.volume_m3 = 0.07;
   f.placement = place;
   for (int tip : {kModelRightHandTip, kModelLeftHandTip}) {
+    if (!arms[tip == kModelRightHandTip ? 0 : 1]) continue;
     const Vector3d shoulder = body.joints[tip - 3], elbow = body.joints[tip - 2], hand = body.joints[tip];
     for (double t = 0.2; t <= 1.0; t += 0.2) {
       AxisPoint3d a;
@@ -260,12 +264,10 @@ TEST(RestState, LearnsTheRestRuleFromSamples) {
   std::filesystem::remove(file);
 }
 
-// Thesis 6.4: silhouettes cannot tell an arm wrapped near the body from a
-// hanging one. Besides the SVM, an arm is at rest when forcing it down costs
-// the estimate next to nothing (PoseTrackerOptions::rest_max_log_overlap_loss).
-// The SVM here is trained on a rule no arm in this test meets (upper arm
-// within 30 deg of straight up), so only that test can find the hanging arm.
-std::vector<std::array<bool, 2>> RestDecisions(double max_loss) {
+// An SVM trained on a rule no arm in these tests meets (upper arm within 30
+// deg of straight up), so that only the tracker's other rest tests can find
+// an arm at rest.
+std::shared_ptr<RestClassifier> NeverRestSvm() {
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0, 1);
   std::vector<std::array<float, 6>> x;
@@ -276,20 +278,20 @@ std::vector<std::array<bool, 2>> RestDecisions(double max_loss) {
     x.push_back(ArmFeatures(u, f));
     y.push_back(u.z() > std::cos(30 * M_PI / 180));
   }
-  auto svm = std::make_shared<RestClassifier>(RestClassifier::Train(x, y, 3, nullptr));
+  return std::make_shared<RestClassifier>(RestClassifier::Train(x, y, 3, nullptr));
+}
+
+// Rest decisions (right, left) over frames 5-19 of a tracker following
+// `truth`, the front end reporting the arms `arms` shows.
+std::vector<std::array<bool, 2>> RestDecisions(const PoseTrackerOptions& options, const BodyPose& truth,
+                                               std::array<bool, 2> arms) {
   const std::vector<Camera> cams = PinholeRig();
   const BodyShape shape = BodyShape::FromHeight(1.75);
-  PoseTrackerOptions options;
-  options.seed = 6;
-  options.rest_max_log_overlap_loss = max_loss;
   PoseTracker tracker(cams, {}, options);
-  tracker.set_rest_classifier(svm);
-  BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
-  truth.dof[kDofRightShoulderAzimuth] = M_PI / 2;  // right arm forward, horizontal
-  truth.dof[kDofRightShoulderZenith] = M_PI / 2;
+  tracker.set_rest_classifier(NeverRestSvm());
   std::vector<std::array<bool, 2>> decisions;
   for (int f = 0; f < 20; ++f) {
-    const PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30);
+    const PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, f, arms), 1.0 / 30);
     EXPECT_TRUE(e.tracking) << f;
     if (!e.rest[0] || !e.rest[1]) {
       ADD_FAILURE() << "no rest decision at frame " << f;
@@ -300,18 +302,96 @@ std::vector<std::array<bool, 2>> RestDecisions(double max_loss) {
   return decisions;
 }
 
+// Thesis 6.4: silhouettes cannot tell an arm wrapped near the body from a
+// hanging one. Besides the SVM, an arm the axis points do not show is at rest
+// when forcing it down costs the estimate next to nothing
+// (PoseTrackerOptions::rest_max_log_overlap_loss).
 TEST(RestState, AnArmTheSilhouettesCannotTellFromHangingIsAtRest) {
-  const auto with_test = RestDecisions(PoseTrackerOptions().rest_max_log_overlap_loss);
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  truth.dof[kDofRightShoulderAzimuth] = M_PI / 2;  // right arm forward, horizontal
+  truth.dof[kDofRightShoulderZenith] = M_PI / 2;
+  PoseTrackerOptions options;
+  options.seed = 6;
+  // The front end sees the raised right arm, not the hanging left one.
+  const auto with_test = RestDecisions(options, truth, {true, false});
   ASSERT_EQ(with_test.size(), 15u);
   for (const auto& [right, left] : with_test) {
     EXPECT_FALSE(right) << "the raised right arm is not at rest";
     EXPECT_TRUE(left) << "the hanging left arm is at rest";
   }
   // Without the test the SVM alone decides, and it finds neither arm at rest.
-  for (const auto& [right, left] : RestDecisions(0.0)) {
+  options.rest_max_log_overlap_loss = 0;
+  for (const auto& [right, left] : RestDecisions(options, truth, {true, false})) {
     EXPECT_FALSE(right);
     EXPECT_FALSE(left);
   }
+}
+
+// An arm the 3D axis points show apart from the body is at rest when they
+// hang within rest_seen_max_angle_deg of straight down, whatever the SVM says.
+TEST(RestState, AnArmSeenHangingIsAtRestAndOneSeenLiftedIsNot) {
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  // Both arms out to the side, straight: the right 20 deg from straight
+  // down, the left 50 deg.
+  for (int sh : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
+    truth.dof[sh] = 0.0;
+    truth.dof[sh + 2] = 0.0;
+  }
+  truth.dof[kDofRightShoulderZenith] = 20 * M_PI / 180;
+  truth.dof[kDofLeftShoulderZenith] = 50 * M_PI / 180;
+  for (int el : {kDofRightElbowAzimuth, kDofLeftElbowAzimuth}) truth.dof[el] = truth.dof[el + 1] = 0.0;
+  PoseTrackerOptions options;
+  options.seed = 7;
+  options.rest_max_log_overlap_loss = 0;  // the angle alone decides
+  const auto decisions = RestDecisions(options, truth, {true, true});
+  ASSERT_EQ(decisions.size(), 15u);
+  for (const auto& [right, left] : decisions) {
+    EXPECT_TRUE(right) << "the right arm hangs 20 deg from straight down";
+    EXPECT_FALSE(left) << "the left arm is lifted 50 deg";
+  }
+  // At a limit of 15 deg neither is at rest.
+  options.rest_seen_max_angle_deg = 15;
+  for (const auto& [right, left] : RestDecisions(options, truth, {true, true})) {
+    EXPECT_FALSE(right);
+    EXPECT_FALSE(left);
+  }
+}
+
+// An arm the axis points showed lifted and then lose is not taken for
+// hanging by the likelihood-ratio test for rest_lifted_memory_s, even when
+// the silhouettes lose it too (noise, an arm overhead against the head).
+TEST(RestState, AnArmJustSeenLiftedIsNotTakenForHangingWhenItVanishes) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  const BodyPose hanging = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  BodyPose lifted = hanging;
+  lifted.dof[kDofRightShoulderAzimuth] = 0.0;  // out to the side, horizontal
+  lifted.dof[kDofRightShoulderZenith] = M_PI / 2;
+  auto right_arm_decisions = [&](double memory_s) {
+    PoseTrackerOptions options;
+    options.seed = 8;
+    options.rest_lifted_memory_s = memory_s;
+    PoseTracker tracker(cams, {}, options);
+    tracker.set_rest_classifier(NeverRestSvm());
+    std::vector<bool> right;
+    for (int f = 0; f < 30; ++f) {
+      // Seen lifted for 10 frames; then gone from the axis points, and the
+      // silhouettes show it hanging.
+      const PoseEstimate e = f < 10 ? tracker.Step(ModelFeatures(cams, shape, lifted, f), 1.0 / 30)
+                                    : tracker.Step(ModelFeatures(cams, shape, hanging, f, {false, true}), 1.0 / 30);
+      EXPECT_TRUE(e.tracking && e.rest[0]) << f;
+      right.push_back(e.rest[0].value_or(false));
+    }
+    return right;
+  };
+  const std::vector<bool> with_memory = right_arm_decisions(0.5);
+  for (int f = 5; f < 23; ++f) EXPECT_FALSE(with_memory[f]) << "frame " << f << ": within 0.5 s of seen lifted";
+  for (int f = 27; f < 30; ++f) EXPECT_TRUE(with_memory[f]) << "frame " << f << ": 0.5 s after, hanging";
+  const std::vector<bool> without = right_arm_decisions(0.0);
+  for (int f = 5; f < 10; ++f) EXPECT_FALSE(without[f]) << f;
+  for (int f = 12; f < 30; ++f) EXPECT_TRUE(without[f]) << "frame " << f << ": no memory, hanging";
 }
 
 TEST(RestState, TheShippedModelLoadsAndKnowsHangingFromPointing) {

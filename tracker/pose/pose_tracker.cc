@@ -54,7 +54,13 @@ void PoseTrackerOptions::Check() const {
   if (!(min_overlap >= 0 && min_overlap <= 1)) throw std::invalid_argument("pose.min_overlap must be in [0, 1]");
   if (!(rest_max_log_overlap_loss >= 0)) throw std::invalid_argument("pose.rest_max_log_overlap_loss must be non-negative");
   if (!(max_rise_m >= 0)) throw std::invalid_argument("pose.max_rise_m must be non-negative");
-  if (rest_min_frames < 1) throw std::invalid_argument("pose.rest_min_frames must be at least 1");
+  if (!(rest_seen_max_angle_deg >= 0 && rest_seen_max_angle_deg <= 180)) {
+    throw std::invalid_argument("pose.rest_seen_max_angle_deg must be in [0, 180]");
+  }
+  if (!(rest_lifted_angle_deg >= 0 && rest_lifted_angle_deg <= 180)) {
+    throw std::invalid_argument("pose.rest_lifted_angle_deg must be in [0, 180]");
+  }
+  if (!(rest_lifted_memory_s >= 0)) throw std::invalid_argument("pose.rest_lifted_memory_s must be non-negative");
   if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
   if (!(walk_memory_s >= 0)) throw std::invalid_argument("pose.walk_memory_s must be non-negative");
 }
@@ -448,7 +454,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   if (!features.placement || features.cameras.size() != cameras_.size()) {
     active_ = false;
     lost_ = false;
-    rest_test_run_[0] = rest_test_run_[1] = 0;
+    lifted_age_s_ = {kNever, kNever};
     out.ms_total = Millis(start);
     return out;
   }
@@ -640,7 +646,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   }
   out.shape = shape_;
   out.body = PoseBody(shape_, out.pose);
-  if (!out.tracking) rest_test_run_[0] = rest_test_run_[1] = 0;
+  if (!out.tracking) lifted_age_s_ = {kNever, kNever};
   if (out.tracking && rest_ && !rest_->empty()) {
     // Thesis 6.4: an arm at rest is forced down. The decision is a vote of
     // the particles, weighted by their likelihood tempered tenfold: an arm
@@ -654,7 +660,9 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     }
     // The estimate's log-likelihood for the likelihood-ratio test, kept up
     // to date when an arm is forced down.
-    double estimate_ll = options_.rest_max_log_overlap_loss > 0 ? Evaluate(out.pose, views, nullptr) : 0.0;
+    double estimate_ll = Evaluate(out.pose, views, nullptr);
+    const auto arm_points = ArmPointsBySide(arm_chains_.points, arm_chains_.chain, arm_chains_.count,
+                                            out.body.joints[kModelRightShoulder], out.body.joints[kModelLeftShoulder]);
     for (int side = 0; side < 2; ++side) {
       const bool left = side == 1;
       double rest_weight = 0, total_weight = 0;
@@ -668,23 +676,60 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
         rest_weight += r ? vote_weight[i] : 0.0;
         total_weight += vote_weight[i];
       }
+      // Forced down: the hanging pose the silhouettes like best, of straight
+      // down a little out from the side or a little forward, the forearm
+      // straight or bent forward. People seldom hang their arms dead
+      // straight; against a single straight pose a bent hanging arm lost
+      // enough overlap to fail the likelihood-ratio test.
       const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
       const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
       BodyPose down = out.pose;
-      down.dof[sh] = 0.0;
-      down.dof[sh + 1] = 0.1;
-      down.dof[sh + 2] = 0.0;
-      down.dof[el] = 0.0;
-      down.dof[el + 1] = 0.0;
+      double down_ll = -std::numeric_limits<double>::infinity();
+      for (const double shoulder_azimuth : {0.0, M_PI / 2}) {
+        for (const double elbow_zenith : {0.0, 0.4, 0.8}) {
+          BodyPose candidate = out.pose;
+          candidate.dof[sh] = shoulder_azimuth;
+          candidate.dof[sh + 1] = shoulder_azimuth == 0.0 ? 0.1 : 0.15;
+          candidate.dof[sh + 2] = 0.0;
+          candidate.dof[el] = M_PI / 2;  // forward
+          candidate.dof[el + 1] = elbow_zenith;
+          const double ll = Evaluate(candidate, views, nullptr);
+          if (ll > down_ll) {
+            down_ll = ll;
+            down = candidate;
+          }
+        }
+      }
       bool at_rest = rest_weight > 0.5 * total_weight;
-      double down_ll = 0;
-      if (options_.rest_max_log_overlap_loss > 0) {
+      // An arm the 3D axis points show apart from the body is where they
+      // are: at rest when they hang within rest_seen_max_angle_deg of
+      // straight down (PoseTrackerOptions). Only an arm they do not show
+      // (against the torso, or in front of it in every view) is left to the
+      // likelihood-ratio test, which would take an arm just lifting off the
+      // side for one still hanging.
+      const Vector3d shoulder = out.body.joints[left ? kModelLeftShoulder : kModelRightShoulder];
+      std::optional<Vector3d> farthest;
+      double farthest_d = 0.15;
+      for (const Vector3d& p : arm_points[side]) {
+        const double d = (p - shoulder).norm();
+        if (d > farthest_d) {
+          farthest_d = d;
+          farthest = p;
+        }
+      }
+      if (farthest) {
+        const double angle = std::acos(std::clamp(-(*farthest - shoulder).normalized().z(), -1.0, 1.0)) * 180 / M_PI;
+        at_rest = at_rest || angle < options_.rest_seen_max_angle_deg;
+        lifted_age_s_[side] = angle >= options_.rest_lifted_angle_deg ? 0.0 : kNever;
+      } else {
+        lifted_age_s_[side] += dt;
         // The likelihood-ratio test (PoseTrackerOptions::rest_max_log_overlap_loss)
-        // against the estimate as it stands (the other arm perhaps forced down).
-        down_ll = Evaluate(down, views, nullptr);
+        // against the estimate as it stands (the other arm perhaps forced down);
+        // not for an arm just seen lifted, which has left the silhouettes
+        // rather than dropped to the side unseen.
         const double loss = (estimate_ll - down_ll) / options_.observation.sharpness;
-        rest_test_run_[side] = loss < options_.rest_max_log_overlap_loss ? rest_test_run_[side] + 1 : 0;
-        at_rest = at_rest || rest_test_run_[side] >= options_.rest_min_frames;
+        at_rest = at_rest || (options_.rest_max_log_overlap_loss > 0 && loss < options_.rest_max_log_overlap_loss &&
+                              lifted_age_s_[side] > options_.rest_lifted_memory_s);
       }
       out.rest[side] = at_rest;
       if (at_rest) {
