@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <utility>
 
 namespace irbench {
 namespace {
@@ -61,6 +62,9 @@ void PoseTrackerOptions::Check() const {
     throw std::invalid_argument("pose.rest_lifted_angle_deg must be in [0, 180]");
   }
   if (!(rest_lifted_memory_s >= 0)) throw std::invalid_argument("pose.rest_lifted_memory_s must be non-negative");
+  if (rest_lifted_angle_deg < rest_seen_max_angle_deg) {
+    throw std::invalid_argument("pose.rest_lifted_angle_deg must be at least pose.rest_seen_max_angle_deg");
+  }
   if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
   if (!(walk_memory_s >= 0)) throw std::invalid_argument("pose.walk_memory_s must be non-negative");
 }
@@ -235,6 +239,24 @@ std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<Vector3d>
   return out;
 }
 
+// Arm axis points farther than this from the shoulder show the arm apart
+// from the body.
+constexpr double kArmApartM = 0.15;
+
+// The arm point farthest from the shoulder, if one lies beyond kArmApartM.
+std::optional<Vector3d> FarthestArmPoint(const std::vector<Vector3d>& points, const Vector3d& shoulder) {
+  std::optional<Vector3d> farthest;
+  double farthest_d = kArmApartM;
+  for (const Vector3d& p : points) {
+    const double d = (p - shoulder).norm();
+    if (d > farthest_d) {
+      farthest_d = d;
+      farthest = p;
+    }
+  }
+  return farthest;
+}
+
 }  // namespace
 
 BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& features) {
@@ -253,15 +275,10 @@ BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& f
     if ((only == 2 && arm != kRightUpperArm) || (only == 3 && arm != kLeftUpperArm)) continue;
     const Vector3d shoulder = body.frames[arm].translation();
     const std::vector<Vector3d>& points = by_side[arm == kRightUpperArm ? 0 : 1];
+    const std::optional<Vector3d> farthest = FarthestArmPoint(points, shoulder);
     std::vector<Vector3d> upper_points;
-    std::optional<Vector3d> farthest;
-    double farthest_d = 0.15;
     for (const Vector3d& p : points) {
       const double d = (p - shoulder).norm();
-      if (d > farthest_d) {
-        farthest_d = d;
-        farthest = p;
-      }
       if (d > 0.06 && d < shape_.upper_arm_m) upper_points.push_back(p);
     }
     Vector3d upper, fore;
@@ -276,7 +293,7 @@ BodyPose PoseTracker::ArmDirectionProposal(BodyPose pose, const FrameFeatures& f
     } else {
       const double reach = shape_.upper_arm_m + shape_.forearm_m + 0.5 * shape_.hand_m;
       upper = fore = (*farthest - shoulder).normalized();
-      if (farthest_d < 0.9 * reach && !upper_points.empty()) {
+      if ((*farthest - shoulder).norm() < 0.9 * reach && !upper_points.empty()) {
         std::uniform_int_distribution<size_t> pick(0, upper_points.size() - 1);
         upper = (upper_points[pick(rng_)] - shoulder).normalized();
         const Vector3d elbow = shoulder + shape_.upper_arm_m * upper;
@@ -648,19 +665,22 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   out.body = PoseBody(shape_, out.pose);
   if (!out.tracking) lifted_age_s_ = {kNever, kNever};
   if (out.tracking && rest_ && !rest_->empty()) {
-    // Thesis 6.4: an arm at rest is forced down. The decision is a vote of
-    // the particles, weighted by their likelihood tempered tenfold: an arm
-    // against the torso is poorly determined, and the best particle alone
-    // flickers between nearby poses.
+    // Thesis 6.4: an arm at rest is forced down. The SVM's part of the
+    // decision is a vote of the particles, weighted by their likelihood
+    // tempered tenfold: an arm against the torso is poorly determined, and
+    // the best particle alone flickers between nearby poses. Besides it, an
+    // arm the 3D axis points show apart from the body is judged by their
+    // angle, and one they do not show by the likelihood-ratio test
+    // (PoseTrackerOptions).
     std::vector<double> vote_weight(n);
     std::vector<std::optional<PosedBody>> voters(n);  // posed once, for both arms
     for (int i = 0; i < n; ++i) {
       vote_weight[i] = std::exp((log_likelihood[i] - log_likelihood[best]) / 10.0);
       if (vote_weight[i] >= 1e-3) voters[i] = PoseBody(shape_, proposed[i]);
     }
-    // The estimate's log-likelihood for the likelihood-ratio test, kept up
-    // to date when an arm is forced down.
-    double estimate_ll = Evaluate(out.pose, views, nullptr);
+    // The estimate's log-likelihood for the likelihood-ratio test, evaluated
+    // when first needed and kept up to date when an arm is forced down.
+    std::optional<double> estimate_ll;
     const auto arm_points = ArmPointsBySide(arm_chains_.points, arm_chains_.chain, arm_chains_.count,
                                             out.body.joints[kModelRightShoulder], out.body.joints[kModelLeftShoulder]);
     for (int side = 0; side < 2; ++side) {
@@ -676,20 +696,43 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
         rest_weight += r ? vote_weight[i] : 0.0;
         total_weight += vote_weight[i];
       }
-      // Forced down: the hanging pose the silhouettes like best, of straight
-      // down a little out from the side or a little forward, the forearm
-      // straight or bent forward. People seldom hang their arms dead
-      // straight; against a single straight pose a bent hanging arm lost
-      // enough overlap to fail the likelihood-ratio test.
+      bool at_rest = rest_weight > 0.5 * total_weight;
+      // An arm the 3D axis points show apart from the body is where they
+      // are: at rest when they hang within rest_seen_max_angle_deg of
+      // straight down. Only an arm they do not show (against the torso, or
+      // in front of it in every view) is left to the likelihood-ratio test,
+      // which would take an arm just lifting off the side for one still
+      // hanging; and not one just seen lifted, which has left the
+      // silhouettes rather than dropped to the side unseen.
+      const Vector3d shoulder = out.body.joints[left ? kModelLeftShoulder : kModelRightShoulder];
+      const std::optional<Vector3d> farthest = FarthestArmPoint(arm_points[side], shoulder);
+      if (farthest) {
+        const double angle = std::acos(std::clamp(-(*farthest - shoulder).normalized().z(), -1.0, 1.0)) * 180 / M_PI;
+        at_rest = at_rest || angle < options_.rest_seen_max_angle_deg;
+        lifted_age_s_[side] = angle >= options_.rest_lifted_angle_deg ? 0.0 : kNever;
+      } else {
+        lifted_age_s_[side] += dt;
+      }
+      const bool ratio_test = !farthest && options_.rest_max_log_overlap_loss > 0 &&
+                              lifted_age_s_[side] > options_.rest_lifted_memory_s;
+      if (!at_rest && !ratio_test) {
+        out.rest[side] = false;
+        continue;
+      }
+      // Forced down: the hanging pose the silhouettes like best, out to the
+      // side or a little forward, the forearm straight or bent forward.
+      // People seldom hang their arms dead straight; against a single
+      // straight pose a bent hanging arm lost enough overlap to fail the
+      // likelihood-ratio test.
       const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
       const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
       BodyPose down = out.pose;
       double down_ll = -std::numeric_limits<double>::infinity();
-      for (const double shoulder_azimuth : {0.0, M_PI / 2}) {
+      for (const auto& [shoulder_azimuth, shoulder_zenith] : {std::pair{0.0, 0.1}, std::pair{M_PI / 2, 0.15}}) {
         for (const double elbow_zenith : {0.0, 0.4, 0.8}) {
           BodyPose candidate = out.pose;
           candidate.dof[sh] = shoulder_azimuth;
-          candidate.dof[sh + 1] = shoulder_azimuth == 0.0 ? 0.1 : 0.15;
+          candidate.dof[sh + 1] = shoulder_zenith;
           candidate.dof[sh + 2] = 0.0;
           candidate.dof[el] = M_PI / 2;  // forward
           candidate.dof[el + 1] = elbow_zenith;
@@ -700,36 +743,11 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
           }
         }
       }
-      bool at_rest = rest_weight > 0.5 * total_weight;
-      // An arm the 3D axis points show apart from the body is where they
-      // are: at rest when they hang within rest_seen_max_angle_deg of
-      // straight down (PoseTrackerOptions). Only an arm they do not show
-      // (against the torso, or in front of it in every view) is left to the
-      // likelihood-ratio test, which would take an arm just lifting off the
-      // side for one still hanging.
-      const Vector3d shoulder = out.body.joints[left ? kModelLeftShoulder : kModelRightShoulder];
-      std::optional<Vector3d> farthest;
-      double farthest_d = 0.15;
-      for (const Vector3d& p : arm_points[side]) {
-        const double d = (p - shoulder).norm();
-        if (d > farthest_d) {
-          farthest_d = d;
-          farthest = p;
-        }
-      }
-      if (farthest) {
-        const double angle = std::acos(std::clamp(-(*farthest - shoulder).normalized().z(), -1.0, 1.0)) * 180 / M_PI;
-        at_rest = at_rest || angle < options_.rest_seen_max_angle_deg;
-        lifted_age_s_[side] = angle >= options_.rest_lifted_angle_deg ? 0.0 : kNever;
-      } else {
-        lifted_age_s_[side] += dt;
-        // The likelihood-ratio test (PoseTrackerOptions::rest_max_log_overlap_loss)
-        // against the estimate as it stands (the other arm perhaps forced down);
-        // not for an arm just seen lifted, which has left the silhouettes
-        // rather than dropped to the side unseen.
-        const double loss = (estimate_ll - down_ll) / options_.observation.sharpness;
-        at_rest = at_rest || (options_.rest_max_log_overlap_loss > 0 && loss < options_.rest_max_log_overlap_loss &&
-                              lifted_age_s_[side] > options_.rest_lifted_memory_s);
+      if (!at_rest) {
+        // The likelihood-ratio test against the estimate as it stands (the
+        // other arm perhaps forced down).
+        if (!estimate_ll) estimate_ll = Evaluate(out.pose, views, nullptr);
+        at_rest = (*estimate_ll - down_ll) / options_.observation.sharpness < options_.rest_max_log_overlap_loss;
       }
       out.rest[side] = at_rest;
       if (at_rest) {

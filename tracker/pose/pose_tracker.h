@@ -90,13 +90,13 @@ struct PoseTrackerOptions {
   // down 220, both before rest_lifted_memory_s. A user bowing deeply with
   // hanging arms is taken for at rest.)
   double rest_seen_max_angle_deg = 34;
-  // An arm they do not show is at rest when forcing it down (the pose the
-  // estimate then shows) costs the best particle less than this in the sum
-  // over cameras of log overlap ratio: the silhouettes cannot tell that arm
-  // from a hanging one ("when the arms ... are wrapped near the body, the
-  // silhouettes are visually nearly undistinguishable"). The SVM, trained on
-  // exact joints, takes a hanging arm the filter has put at the torso's side
-  // or behind it for a raised one. 0 turns the test off.
+  // An arm they do not show is at rest when forcing it down (to the best of
+  // six hanging poses, which the estimate then shows) costs less than this
+  // in the sum over cameras of log overlap ratio: the silhouettes cannot
+  // tell that arm from a hanging one ("when the arms ... are wrapped near
+  // the body, the silhouettes are visually nearly undistinguishable"). The
+  // SVM, trained on exact joints, takes a hanging arm the filter has put at
+  // the torso's side or behind it for a raised one. 0 turns the test off.
   double rest_max_log_overlap_loss = 0.27;
   // ... unless the axis points showed it lifted at least rest_lifted_angle_deg
   // from straight down within the last rest_lifted_memory_s: an arm does not
@@ -216,7 +216,7 @@ class PoseTracker {
   bool lost_ = false;
   // Per arm (right, left): seconds since the 3D axis points last showed it
   // lifted (PoseTrackerOptions::rest_lifted_angle_deg); kNever when they
-  // have shown it hanging since, or it has not been seen.
+  // have shown it below that angle since, or have not shown it.
   static constexpr double kNever = 1e9;
   std::array<double, 2> lifted_age_s_ = {kNever, kNever};
 };
