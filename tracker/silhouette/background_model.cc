@@ -110,6 +110,7 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   // slopes too few pixels show significantly (a light change in training too
   // small for the noise) falls back to pixels scaling with the light: the
   // whole stage still brightens with a flash, and L must follow it.
+  cv::Mat light_pixels;  // CV_8U: pixels whose b is large enough to read L from
   const auto fit = [&](bool by_regression) {
     cv::Mat b = by_regression ? cv::Mat(sum_l / (n * light_var))
                 : flicker && light_mean > 1 ? cv::Mat(mean / light_mean)
@@ -129,20 +130,20 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     b.convertTo(m.b_, CV_32F);
     sigma = cv::max(sigma, options.min_sigma);
     sigma.convertTo(m.sigma_, CV_32F);
-    m.light_pixels_ = cv::Mat::zeros(size, CV_8U);
-    if (flicker && !by_regression) m.light_pixels_ = m.b_ > 0.2;
+    light_pixels = cv::Mat::zeros(size, CV_8U);
+    if (flicker && !by_regression) light_pixels = m.b_ > 0.2;
     if (by_regression) {
       for (int y = 0; y < size.height; ++y) {
         const float* bp = m.b_.ptr<float>(y);
         const float* sp = m.sigma_.ptr<float>(y);
-        uint8_t* lp = m.light_pixels_.ptr<uint8_t>(y);
+        uint8_t* lp = light_pixels.ptr<uint8_t>(y);
         for (int x = 0; x < size.width; ++x) {
           // b's standard error is σ / (sqrt(n) · std(L)).
           lp[x] = bp[x] > 0.2 && bp[x] > 3 * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
         }
       }
     }
-    if (!m.screen_.empty()) m.light_pixels_.setTo(0, m.screen_);
+    if (!m.screen_.empty()) light_pixels.setTo(0, m.screen_);
     return dof;
   };
   mean.convertTo(m.mean_, CV_32F);
@@ -152,15 +153,15 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     // estimating L and are modelled by their own gain.
   }
   int dof = fit(regress);
-  if (regress && cv::countNonZero(m.light_pixels_) < kMinLightPixels) {
+  if (regress && cv::countNonZero(light_pixels) < kMinLightPixels) {
     regress = false;
     dof = fit(false);
   }
-  m.light_pixel_count_ = cv::countNonZero(m.light_pixels_);
+  m.light_pixel_count_ = cv::countNonZero(light_pixels);
   // The light is read from every other row and column: a quarter of the
   // pixels is plenty for a median.
   for (int y = 0; y < size.height; y += 2) {
-    const uint8_t* lp = m.light_pixels_.ptr<uint8_t>(y);
+    const uint8_t* lp = light_pixels.ptr<uint8_t>(y);
     for (int x = 0; x < size.width; x += 2) {
       if (lp[x]) m.light_samples_.push_back({y, x});
     }

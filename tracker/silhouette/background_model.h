@@ -98,9 +98,8 @@ class BackgroundModel {
   double EstimateScreenGain(const cv::Mat& frame) const;
   double PoolSigmaPx(int width) const { return options_.pool_sigma * width / 320.0; }
 
-  cv::Mat light_pixels_;  // CV_8U: pixels whose b is large enough to read L from
-  int light_pixel_count_ = 0;
-  std::vector<std::pair<int, int>> light_samples_;  // (y, x): the light pixels on even rows and columns
+  int light_pixel_count_ = 0;  // pixels whose b is large enough to read L from
+  std::vector<std::pair<int, int>> light_samples_;  // (y, x): those on even rows and columns
   cv::Mat screen_;        // CV_8U: screen pixels (may be empty)
   cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;
