@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <random>
+#include <opencv2/imgproc.hpp>
 #include <unistd.h>
 
 #include "common/error.h"
@@ -151,6 +152,53 @@ double WorstJointError(const PosedBody& a, const PosedBody& b) {
   return worst;
 }
 
+// The head joint (the pointing rays' origin) is the voxel hull's head where
+// every camera sees the model's head, and the model's own where a camera has
+// lost it: such a view has carved the head from the hull too.
+TEST(PoseTracker, TakesTheHeadFromTheHullOnlyWhereEveryViewSeesIt) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTrackerOptions options;
+  options.seed = 5;
+  PoseTracker tracker(cams, {}, options);
+  const BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  const PosedBody body = PoseBody(shape, truth);
+  for (int f = 0; f < 10; ++f) ASSERT_TRUE(tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30).tracking);
+  // A hull whose head is a ball 3 cm to the side of the model's.
+  VoxelHull hull;
+  hull.origin_m = Vector3d(-1, -1, 0);
+  hull.voxel_size_m = 0.02;
+  hull.nx = hull.ny = 100;
+  hull.nz = 110;
+  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  const Vector3d ball = body.joints[kModelHead] + Vector3d(0.03, 0, 0);
+  for (int z = 0; z < hull.nz; ++z) {
+    for (int y = 0; y < hull.ny; ++y) {
+      for (int x = 0; x < hull.nx; ++x) {
+        if ((hull.VoxelCenter(x, y, z) - ball).norm() < 0.1) hull.occupied[hull.Index(x, y, z)] = 1;
+      }
+    }
+  }
+  FrameFeatures seen = ModelFeatures(cams, shape, truth, 10);
+  seen.voxels = hull;
+  PoseEstimate e = tracker.Step(seen, 1.0 / 30);
+  ASSERT_TRUE(e.tracking);
+  const Vector3d model_head = PoseBody(e.shape, e.pose).joints[kModelHead];
+  EXPECT_NEAR(e.body.joints[kModelHead].x(), ball.x(), 0.011);  // the ball's centroid, within half a voxel
+  EXPECT_GT((e.body.joints[kModelHead] - model_head).norm(), 0.015);
+  ASSERT_TRUE(e.pointing[0]);
+  EXPECT_NEAR((e.pointing[0]->origin - e.body.joints[kModelHead]).norm(), 0.0, 1e-12);
+
+  // One camera loses the head.
+  FrameFeatures lost = ModelFeatures(cams, shape, truth, 11);
+  lost.voxels = hull;
+  const Eigen::Vector3d p = ProjectionMatrix(cams[0]) * body.joints[kModelHead].homogeneous();
+  cv::circle(lost.cameras[0].silhouette, cv::Point2d(p.x() / p.z(), p.y() / p.z()), 25, cv::Scalar(0), cv::FILLED);
+  e = tracker.Step(lost, 1.0 / 30);
+  ASSERT_TRUE(e.tracking);
+  EXPECT_NEAR((e.body.joints[kModelHead] - PoseBody(e.shape, e.pose).joints[kModelHead]).norm(), 0.0, 1e-12);
+}
+
 TEST(PoseTracker, FollowsAModelRaisingItsArmAndRecoversFromScattering) {
   const std::vector<Camera> cams = PinholeRig();
   const BodyShape shape = BodyShape::FromHeight(1.75);
@@ -216,6 +264,60 @@ TEST(Pointing, RayFromHeadThroughHandTipHitsTheNearestScreen) {
   EXPECT_NEAR(ray->screen_hit->y(), hit.z(), 1e-9);
   EXPECT_EQ(ray->target.value_or(""), "door");
   EXPECT_FALSE(Pointing(head, head, {near_screen}));
+}
+
+// The head centre is read off the voxel hull, not the model: a ball of a
+// head on a trunk with an arm held out at shoulder height, and a model head
+// a couple of centimetres off. The ball sits on voxel centres, so its
+// voxels' centroid is its centre exactly.
+TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
+  VoxelHull hull;
+  hull.origin_m = Vector3d(-1, -1, 0);
+  hull.voxel_size_m = 0.02;
+  hull.nx = hull.ny = 100;
+  hull.nz = 110;
+  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  const Vector3d ball(0.13, -0.07, 1.61);  // a voxel centre's x and y
+  const double radius = 0.09;              // the crown at 1.70, a voxel layer's upper face
+  auto fill = [&](auto inside) {
+    for (int z = 0; z < hull.nz; ++z) {
+      for (int y = 0; y < hull.ny; ++y) {
+        for (int x = 0; x < hull.nx; ++x) {
+          if (inside(hull.VoxelCenter(x, y, z))) hull.occupied[hull.Index(x, y, z)] = 1;
+        }
+      }
+    }
+  };
+  fill([&](const Vector3d& c) { return (c - ball).norm() < radius; });
+  fill([&](const Vector3d& c) {  // trunk, and the right arm held out sideways at shoulder height
+    const Vector3d d = c - ball;
+    const bool trunk = std::abs(d.x()) < 0.2 && std::abs(d.y()) < 0.1 && c.z() > 0.9 && c.z() < 1.45;
+    const bool arm = d.x() > 0.2 && d.x() < 0.8 && std::abs(d.y()) < 0.04 && c.z() > 1.38 && c.z() < 1.46;
+    return trunk || arm;
+  });
+  const double height = 1.7;
+  const Vector3d model_head = ball + Vector3d(0.02, -0.01, -0.03);
+  const Vector3d forward(0, 2, 0);  // facing +y, not unit
+  HullHeadOptions options;
+  const auto head = HullHeadCentre(hull, model_head, forward, height, options);
+  ASSERT_TRUE(head);
+  EXPECT_NEAR(head->x(), ball.x(), 1e-9);
+  EXPECT_NEAR(head->y(), ball.y() - options.back_m, 1e-9);  // moved back against the facing
+  EXPECT_NEAR(head->z(), 1.70 - options.below_top * height, 1e-9);
+
+  // A hand over the head puts the top too far above the model's crown: the
+  // model's head is kept.
+  fill([&](const Vector3d& c) { return (c - (ball + Vector3d(0, 0, 0.24))).norm() < 0.05; });
+  EXPECT_FALSE(HullHeadCentre(hull, model_head, forward, height, options));
+  // No voxels near the head either.
+  EXPECT_FALSE(HullHeadCentre(hull, model_head + Vector3d(0.5, 0, 0), forward, height, options));
+  EXPECT_FALSE(HullHeadCentre(VoxelHull(), model_head, forward, height, options));
+
+  options.slab = 0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  PoseTrackerOptions tracker_options;
+  tracker_options.hull_head.radius_m = -1;
+  EXPECT_THROW(tracker_options.Check(), std::invalid_argument);
 }
 
 }  // namespace
