@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <opencv2/imgproc.hpp>
 #include <unistd.h>
@@ -146,6 +147,28 @@ FrameFeatures ModelFeatures(const std::vector<Camera>& cams, const BodyShape& sh
   return f;
 }
 
+// An empty voxel grid over the stage: 2 x 2 x 2.2 m from (-1, -1, 0), 2 cm voxels.
+VoxelHull EmptyStageHull() {
+  VoxelHull hull;
+  hull.origin_m = Vector3d(-1, -1, 0);
+  hull.voxel_size_m = 0.02;
+  hull.nx = hull.ny = 100;
+  hull.nz = 110;
+  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  return hull;
+}
+
+// Marks occupied the voxels whose centres `inside` holds.
+void FillHull(VoxelHull* hull, const std::function<bool(const Vector3d&)>& inside) {
+  for (int z = 0; z < hull->nz; ++z) {
+    for (int y = 0; y < hull->ny; ++y) {
+      for (int x = 0; x < hull->nx; ++x) {
+        if (inside(hull->VoxelCenter(x, y, z))) hull->occupied[hull->Index(x, y, z)] = 1;
+      }
+    }
+  }
+}
+
 double WorstJointError(const PosedBody& a, const PosedBody& b) {
   double worst = 0;
   for (int j = 0; j < kModelJointCount; ++j) worst = std::max(worst, (a.joints[j] - b.joints[j]).norm());
@@ -165,20 +188,9 @@ TEST(PoseTracker, TakesTheHeadFromTheHullOnlyWhereEveryViewSeesIt) {
   const PosedBody body = PoseBody(shape, truth);
   for (int f = 0; f < 10; ++f) ASSERT_TRUE(tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30).tracking);
   // A hull whose head is a ball 3 cm to the side of the model's.
-  VoxelHull hull;
-  hull.origin_m = Vector3d(-1, -1, 0);
-  hull.voxel_size_m = 0.02;
-  hull.nx = hull.ny = 100;
-  hull.nz = 110;
-  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  VoxelHull hull = EmptyStageHull();
   const Vector3d ball = body.joints[kModelHead] + Vector3d(0.03, 0, 0);
-  for (int z = 0; z < hull.nz; ++z) {
-    for (int y = 0; y < hull.ny; ++y) {
-      for (int x = 0; x < hull.nx; ++x) {
-        if ((hull.VoxelCenter(x, y, z) - ball).norm() < 0.1) hull.occupied[hull.Index(x, y, z)] = 1;
-      }
-    }
-  }
+  FillHull(&hull, [&](const Vector3d& c) { return (c - ball).norm() < 0.1; });
   FrameFeatures seen = ModelFeatures(cams, shape, truth, 10);
   seen.voxels = hull;
   PoseEstimate e = tracker.Step(seen, 1.0 / 30);
@@ -271,25 +283,11 @@ TEST(Pointing, RayFromHeadThroughHandTipHitsTheNearestScreen) {
 // a couple of centimetres off. The ball sits on voxel centres, so its
 // voxels' centroid is its centre exactly.
 TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
-  VoxelHull hull;
-  hull.origin_m = Vector3d(-1, -1, 0);
-  hull.voxel_size_m = 0.02;
-  hull.nx = hull.ny = 100;
-  hull.nz = 110;
-  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  VoxelHull hull = EmptyStageHull();
   const Vector3d ball(0.13, -0.07, 1.61);  // a voxel centre's x and y
   const double radius = 0.09;              // the crown at 1.70, a voxel layer's upper face
-  auto fill = [&](auto inside) {
-    for (int z = 0; z < hull.nz; ++z) {
-      for (int y = 0; y < hull.ny; ++y) {
-        for (int x = 0; x < hull.nx; ++x) {
-          if (inside(hull.VoxelCenter(x, y, z))) hull.occupied[hull.Index(x, y, z)] = 1;
-        }
-      }
-    }
-  };
-  fill([&](const Vector3d& c) { return (c - ball).norm() < radius; });
-  fill([&](const Vector3d& c) {  // trunk, and the right arm held out sideways at shoulder height
+  FillHull(&hull, [&](const Vector3d& c) { return (c - ball).norm() < radius; });
+  FillHull(&hull, [&](const Vector3d& c) {  // trunk, and the right arm held out sideways at shoulder height
     const Vector3d d = c - ball;
     const bool trunk = std::abs(d.x()) < 0.2 && std::abs(d.y()) < 0.1 && c.z() > 0.9 && c.z() < 1.45;
     const bool arm = d.x() > 0.2 && d.x() < 0.8 && std::abs(d.y()) < 0.04 && c.z() > 1.38 && c.z() < 1.46;
@@ -307,7 +305,7 @@ TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
 
   // A hand over the head puts the top too far above the model's crown: the
   // model's head is kept.
-  fill([&](const Vector3d& c) { return (c - (ball + Vector3d(0, 0, 0.24))).norm() < 0.05; });
+  FillHull(&hull, [&](const Vector3d& c) { return (c - (ball + Vector3d(0, 0, 0.24))).norm() < 0.05; });
   EXPECT_FALSE(HullHeadCentre(hull, model_head, forward, height, options));
   // No voxels near the head either.
   EXPECT_FALSE(HullHeadCentre(hull, model_head + Vector3d(0.5, 0, 0), forward, height, options));

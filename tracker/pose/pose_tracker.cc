@@ -650,19 +650,19 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
       // at 1.5, the heavy p3 (who takes 1.65-2.0) kept a torso too narrow,
       // and the filter spread the arms to cover it (full suite, seeds 1-3:
       // p3's rest 93 -> 98 %, waist 5.6 -> 4.0 cm).
-      const double best_height = std::clamp(features.placement->top_m, 1.2, 2.2);
+      const double top_height = std::clamp(features.placement->top_m, 1.2, 2.2);
       double best_ll = -std::numeric_limits<double>::infinity(), best_girth = 1.0;
       BodyPose upright = out.pose;
       for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) upright.dof[d] = 0;
-      upright.dof[kDofZ] *= best_height / shape_.height_m;
+      upright.dof[kDofZ] *= top_height / shape_.height_m;
       for (double girth : {0.9, 1.05, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.2, 2.4}) {
-        const double ll = Evaluate(BodyShape::FromHeight(best_height, girth), upright, views, nullptr);
+        const double ll = Evaluate(BodyShape::FromHeight(top_height, girth), upright, views, nullptr);
         if (ll > best_ll) {
           best_ll = ll;
           best_girth = girth;
         }
       }
-      heights_.push_back(best_height);
+      heights_.push_back(top_height);
       girths_.push_back(best_girth);
       const double height = std::clamp(Median(heights_), 1.2, 2.2);
       const double ratio = height / shape_.height_m;
