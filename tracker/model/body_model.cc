@@ -82,10 +82,11 @@ const char* ModelJointName(int joint) {
   return joint >= 0 && joint < kModelJointCount ? names[joint] : "?";
 }
 
-BodyShape BodyShape::FromHeight(double h, double girth) {
+BodyShape BodyShape::FromHeight(double h, double girth, double arm_thickness) {
   BodyShape s;
   s.height_m = h;
   s.girth = girth;
+  s.arm_thickness = arm_thickness;
   s.waist_height_m = 0.600 * h;
   s.torso_length_m = 0.218 * h;
   // Half of Drillis and Contini's shoulder width (0.259), less the deltoid
@@ -124,7 +125,8 @@ BodyShape BodyShape::FromHeight(double h, double girth) {
     s.radii[arm + 1] = Vector3d(0.025 * h, 0.025 * h, 0.135 / 0.254 * lower);
     s.center_along[arm + 1] = -0.5 * lower;
   }
-  const Eigen::Vector3d wide(girth, girth, 1.0), arm_wide(std::sqrt(girth), std::sqrt(girth), 1.0);
+  const double arm = std::sqrt(girth) * arm_thickness;
+  const Eigen::Vector3d wide(girth, girth, 1.0), arm_wide(arm, arm, 1.0);
   for (int seg : {kLowerBody, kUpperBody}) s.radii[seg] = s.radii[seg].cwiseProduct(wide);
   for (int seg : {kRightUpperArm, kRightLowerArm, kLeftUpperArm, kLeftLowerArm}) {
     s.radii[seg] = s.radii[seg].cwiseProduct(arm_wide);

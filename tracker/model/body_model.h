@@ -68,9 +68,12 @@ const char* BodyDofName(int dof);
 // proportionally to the estimated height of the user". `girth` widens the
 // torso's and legs' ellipsoids (and the arms' by its square root): the
 // thesis notes height scaling alone fails "users who are too thin or obese".
+// `arm_thickness` widens the arms' ellipsoids further: sleeves (a jacket)
+// make arms thicker than a torso's girth says.
 struct BodyShape {
   double height_m = 1.75;
   double girth = 1.0;
+  double arm_thickness = 1.0;
   double waist_height_m = 0;     // waist joint above the floor, standing
   double torso_length_m = 0;     // waist joint to neck joint
   double shoulder_offset_m = 0;  // shoulder joint from the body's midline (x)
@@ -94,7 +97,7 @@ struct BodyShape {
   // hanging below it).
   std::array<double, kSegmentCount> center_along;
 
-  static BodyShape FromHeight(double height_m, double girth = 1.0);
+  static BodyShape FromHeight(double height_m, double girth = 1.0, double arm_thickness = 1.0);
 };
 
 struct BodyPose {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace irbench {
@@ -38,6 +39,31 @@ TEST(BodyModel, StandingPoseHasTheProportionsItWasScaledTo) {
   EXPECT_NEAR((body.joints[kModelLeftWrist] - body.joints[kModelLeftElbow]).norm(), shape.forearm_m, 1e-12);
   EXPECT_NEAR((body.joints[kModelLeftHandTip] - body.joints[kModelLeftElbow]).norm(), shape.forearm_m + shape.hand_m,
               1e-12);
+}
+
+// arm_thickness widens the arms' ellipsoids across, on top of the girth's
+// square root, and changes nothing else: not their lengths, not the trunk,
+// not a joint.
+TEST(BodyModel, ArmThicknessWidensOnlyTheArmsAcross) {
+  const BodyShape plain = BodyShape::FromHeight(1.80, 1.5);
+  const BodyShape thick = BodyShape::FromHeight(1.80, 1.5, 1.25);
+  EXPECT_EQ(plain.arm_thickness, 1.0);
+  EXPECT_EQ(thick.arm_thickness, 1.25);
+  for (int seg = 0; seg < kSegmentCount; ++seg) {
+    const bool arm = seg == kRightUpperArm || seg == kRightLowerArm || seg == kLeftUpperArm || seg == kLeftLowerArm;
+    const double across = arm ? 1.25 : 1.0;
+    EXPECT_NEAR(thick.radii[seg].x(), across * plain.radii[seg].x(), 1e-12) << BodySegmentName(seg);
+    EXPECT_NEAR(thick.radii[seg].y(), across * plain.radii[seg].y(), 1e-12) << BodySegmentName(seg);
+    EXPECT_NEAR(thick.radii[seg].z(), plain.radii[seg].z(), 1e-12) << BodySegmentName(seg);
+    EXPECT_NEAR(thick.center_along[seg], plain.center_along[seg], 1e-12) << BodySegmentName(seg);
+  }
+  // The arms' radius across is the girth's square root times arm_thickness
+  // of the unwidened one.
+  EXPECT_NEAR(thick.radii[kRightUpperArm].x(),
+              std::sqrt(1.5) * 1.25 * BodyShape::FromHeight(1.80).radii[kRightUpperArm].x(), 1e-12);
+  const BodyPose pose = ScarecrowPose(plain, Vector2d(0.1, 0.2), 0.4);
+  const PosedBody a = PoseBody(plain, pose), b = PoseBody(thick, pose);
+  for (int j = 0; j < kModelJointCount; ++j) EXPECT_NEAR((a.joints[j] - b.joints[j]).norm(), 0, 1e-12) << j;
 }
 
 TEST(BodyModel, ScarecrowArmsPointToThePersonsSidesWhateverTheYaw) {

@@ -211,6 +211,62 @@ TEST(PoseTracker, TakesTheHeadFromTheHullOnlyWhereEveryViewSeesIt) {
   EXPECT_NEAR((e.body.joints[kModelHead] - PoseBody(e.shape, e.pose).joints[kModelHead]).norm(), 0.0, 1e-12);
 }
 
+// The model's arms take the thickness the 3D arm axis points measure (a
+// jacket's sleeves): their median diameter over arm_reference_diameter
+// times the height, never thinner than bare arms nor past
+// max_arm_thickness, and fixed once arm_thickness_frames frames have given
+// arm points.
+TEST(PoseTracker, ThickensTheArmsToTheAxisPointsDiameters) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  const BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  // Tracks 12 frames whose arm points (20 a frame) are diameter(frame) across.
+  auto track = [&](const std::function<double(int)>& diameter, PoseTrackerOptions options) {
+    options.seed = 3;
+    options.arm_thickness_min_points = 40;
+    PoseTracker tracker(cams, {}, options);
+    PoseEstimate e;
+    for (int f = 0; f < 12; ++f) {
+      FrameFeatures features = ModelFeatures(cams, shape, truth, f);
+      for (AxisPoint3d& a : features.axis3d) a.diameter_m = diameter(f);
+      e = tracker.Step(features, 1.0 / 30);
+      EXPECT_TRUE(e.tracking) << f;
+      if (f == 0) {
+        EXPECT_EQ(e.shape.arm_thickness, 1.0) << "20 points, under arm_thickness_min_points";
+      }
+    }
+    return e;
+  };
+  const PoseTrackerOptions options;
+  const double reference = options.arm_reference_diameter * shape.height_m;
+  PoseEstimate e = track([&](int) { return 1.2 * reference; }, options);
+  EXPECT_NEAR(e.shape.height_m, shape.height_m, 0.011);
+  EXPECT_NEAR(e.shape.arm_thickness, 1.2 * shape.height_m / e.shape.height_m, 1e-9);
+  const BodyShape expected = BodyShape::FromHeight(e.shape.height_m, e.shape.girth, e.shape.arm_thickness);
+  for (int seg = 0; seg < kSegmentCount; ++seg) {
+    EXPECT_NEAR((e.shape.radii[seg] - expected.radii[seg]).norm(), 0, 1e-12) << BodySegmentName(seg);
+  }
+  EXPECT_EQ(track([&](int) { return 0.5 * reference; }, options).shape.arm_thickness, 1.0);
+  EXPECT_EQ(track([&](int) { return 3.0 * reference; }, options).shape.arm_thickness, options.max_arm_thickness);
+  // Points without a diameter measure nothing.
+  EXPECT_EQ(track([&](int) { return 0.0; }, options).shape.arm_thickness, 1.0);
+  // Three frames of thick arms, then thin ones: the thin ones come too late.
+  PoseTrackerOptions three = options;
+  three.arm_thickness_frames = 3;
+  e = track([&](int f) { return f < 3 ? 1.2 * reference : 0.9 * reference; }, three);
+  EXPECT_NEAR(e.shape.arm_thickness, 1.2 * shape.height_m / e.shape.height_m, 0.011);
+  // And the options.
+  for (auto bad : std::vector<std::function<void(PoseTrackerOptions&)>>{
+           [](PoseTrackerOptions& o) { o.arm_thickness_frames = -1; },
+           [](PoseTrackerOptions& o) { o.arm_thickness_min_points = 0; },
+           [](PoseTrackerOptions& o) { o.arm_reference_diameter = 0; },
+           [](PoseTrackerOptions& o) { o.max_arm_thickness = 0.9; }}) {
+    PoseTrackerOptions o;
+    bad(o);
+    EXPECT_THROW(o.Check(), std::invalid_argument);
+  }
+}
+
 TEST(PoseTracker, FollowsAModelRaisingItsArmAndRecoversFromScattering) {
   const std::vector<Camera> cams = PinholeRig();
   const BodyShape shape = BodyShape::FromHeight(1.75);

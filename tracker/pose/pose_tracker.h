@@ -122,6 +122,15 @@ struct PoseTrackerOptions {
   // enters (medians of per-frame values, while the arms are below the
   // shoulders).
   int height_frames = 15;
+  // Arm thickness (BodyShape::arm_thickness) from the 3D arm axis points'
+  // diameters: their median over the first arm_thickness_frames tracked
+  // frames that have arm points, once arm_thickness_min_points are in,
+  // over arm_reference_diameter times the height; at least 1 (the model's
+  // arms are sized for bare or tight sleeves), at most max_arm_thickness.
+  int arm_thickness_frames = 150;
+  int arm_thickness_min_points = 300;
+  double arm_reference_diameter = 0.055;
+  double max_arm_thickness = 1.3;
   void Check() const;  // throws std::invalid_argument
 };
 
@@ -203,6 +212,8 @@ class PoseTracker {
   bool active_ = false;
   BodyShape shape_;
   std::vector<double> heights_, girths_;
+  std::vector<double> arm_diameters_;  // metres, from the 3D arm axis points
+  int arm_frames_ = 0;                 // tracked frames that gave them
   std::vector<BodyPose> particles_, previous_;
   std::deque<Eigen::Vector2d> recent_roots_;
   // This frame's 3D arm axis points in chains, and torso axis points (x, y).
