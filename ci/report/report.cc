@@ -150,7 +150,8 @@ std::string Describe(const fs::path& sequence) {
 }
 
 // The irbench tracker's model for a track line: its 21 `dof` by name,
-// `height_m` and `girth`. nullopt for another tracker's line (no dof).
+// `height_m`, `girth` and `arm_thickness` (1 where a line lacks them).
+// nullopt for another tracker's line (no dof).
 std::optional<PosedBody> TrackedModel(const Json& line) {
   if (!line.contains("dof") || !line["dof"].is_object() || !line.contains("height_m") ||
       !line["height_m"].is_number()) {
@@ -162,8 +163,12 @@ std::optional<PosedBody> TrackedModel(const Json& line) {
     if (it == line["dof"].end() || !it->is_number()) return std::nullopt;
     pose.dof[d] = it->get<double>();
   }
-  const double girth = line.contains("girth") && line["girth"].is_number() ? line["girth"].get<double>() : 1.0;
-  return PoseBody(BodyShape::FromHeight(line["height_m"].get<double>(), girth), pose);
+  auto number_or_one = [&](const char* key) {
+    return line.contains(key) && line[key].is_number() ? line[key].get<double>() : 1.0;
+  };
+  return PoseBody(BodyShape::FromHeight(line["height_m"].get<double>(), number_or_one("girth"),
+                                        number_or_one("arm_thickness")),
+                  pose);
 }
 
 // The viewer's data: cameras, joint names, bones, and per frame the truth's

@@ -280,6 +280,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
       if (pose->rest[0] && pose->rest[1]) track_line["rest"] = {{"right", *pose->rest[0]}, {"left", *pose->rest[1]}};
       track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
       track_line["girth"] = std::round(pose->shape.girth * 1e3) / 1e3;
+      track_line["arm_thickness"] = std::round(pose->shape.arm_thickness * 1e3) / 1e3;
       nlohmann::json overlap = nlohmann::json::object();
       for (size_t c = 0; c < pose->overlap.size(); ++c) {
         overlap[input.cameras()[c].name] = std::round(pose->overlap[c] * 1e4) / 1e4;

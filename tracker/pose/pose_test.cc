@@ -214,48 +214,69 @@ TEST(PoseTracker, TakesTheHeadFromTheHullOnlyWhereEveryViewSeesIt) {
 // The model's arms take the thickness the 3D arm axis points measure (a
 // jacket's sleeves): their median diameter over arm_reference_diameter
 // times the height, never thinner than bare arms nor past
-// max_arm_thickness, and fixed once arm_thickness_frames frames have given
-// arm points.
+// max_arm_thickness, fixed once arm_thickness_frames frames have given arm
+// points, and measured afresh for the next user.
 TEST(PoseTracker, ThickensTheArmsToTheAxisPointsDiameters) {
   const std::vector<Camera> cams = PinholeRig();
   const BodyShape shape = BodyShape::FromHeight(1.75);
   const BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
-  // Tracks 12 frames whose arm points (20 a frame) are diameter(frame) across.
-  auto track = [&](const std::function<double(int)>& diameter, PoseTrackerOptions options) {
-    options.seed = 3;
-    options.arm_thickness_min_points = 40;
-    PoseTracker tracker(cams, {}, options);
+  PoseTrackerOptions options;
+  options.seed = 3;
+  options.arm_thickness_min_points = 40;
+  const double reference = options.arm_reference_diameter * shape.height_m;
+  // Tracks 12 frames whose arm points (20 a frame; ModelFeatures) are
+  // diameter(frame, point) across.
+  auto track = [&](PoseTracker& tracker, const std::function<double(int, int)>& diameter) {
     PoseEstimate e;
     for (int f = 0; f < 12; ++f) {
       FrameFeatures features = ModelFeatures(cams, shape, truth, f);
-      for (AxisPoint3d& a : features.axis3d) a.diameter_m = diameter(f);
+      for (size_t i = 0; i < features.axis3d.size(); ++i) features.axis3d[i].diameter_m = diameter(f, int(i));
       e = tracker.Step(features, 1.0 / 30);
       EXPECT_TRUE(e.tracking) << f;
-      if (f == 0) {
-        EXPECT_EQ(e.shape.arm_thickness, 1.0) << "20 points, under arm_thickness_min_points";
-      }
+      EXPECT_NEAR(e.shape.height_m, shape.height_m, 1e-9) << f;
     }
     return e;
   };
-  const PoseTrackerOptions options;
-  const double reference = options.arm_reference_diameter * shape.height_m;
-  PoseEstimate e = track([&](int) { return 1.2 * reference; }, options);
-  EXPECT_NEAR(e.shape.height_m, shape.height_m, 0.011);
-  EXPECT_NEAR(e.shape.arm_thickness, 1.2 * shape.height_m / e.shape.height_m, 1e-9);
-  const BodyShape expected = BodyShape::FromHeight(e.shape.height_m, e.shape.girth, e.shape.arm_thickness);
-  for (int seg = 0; seg < kSegmentCount; ++seg) {
-    EXPECT_NEAR((e.shape.radii[seg] - expected.radii[seg]).norm(), 0, 1e-12) << BodySegmentName(seg);
+  auto thickness = [&](const std::function<double(int, int)>& diameter, const PoseTrackerOptions& o) {
+    PoseTracker tracker(cams, {}, o);
+    return track(tracker, diameter).shape.arm_thickness;
+  };
+  {
+    PoseTracker tracker(cams, {}, options);
+    PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, 0), 1.0 / 30);
+    EXPECT_EQ(e.shape.arm_thickness, 1.0) << "no diameters yet";
+    e = track(tracker, [&](int, int) { return 1.2 * reference; });
+    EXPECT_NEAR(e.shape.arm_thickness, 1.2, 1e-9);
+    const BodyShape expected = BodyShape::FromHeight(e.shape.height_m, e.shape.girth, 1.2);
+    for (int seg = 0; seg < kSegmentCount; ++seg) {
+      EXPECT_NEAR((e.shape.radii[seg] - expected.radii[seg]).norm(), 0, 1e-9) << BodySegmentName(seg);
+    }
   }
-  EXPECT_EQ(track([&](int) { return 0.5 * reference; }, options).shape.arm_thickness, 1.0);
-  EXPECT_EQ(track([&](int) { return 3.0 * reference; }, options).shape.arm_thickness, options.max_arm_thickness);
-  // Points without a diameter measure nothing.
-  EXPECT_EQ(track([&](int) { return 0.0; }, options).shape.arm_thickness, 1.0);
+  EXPECT_EQ(thickness([&](int, int) { return 0.5 * reference; }, options), 1.0);
+  EXPECT_EQ(thickness([&](int, int) { return 3.0 * reference; }, options), options.max_arm_thickness);
+  // Points without a diameter measure nothing: two in three here, which
+  // would make the median 0 (and the thickness 1) if they counted.
+  EXPECT_NEAR(thickness([&](int, int i) { return i % 3 == 0 ? 1.2 * reference : 0.0; }, options), 1.2, 1e-9);
   // Three frames of thick arms, then thin ones: the thin ones come too late.
+  // Then the user leaves, and the next one's arms are measured afresh.
   PoseTrackerOptions three = options;
   three.arm_thickness_frames = 3;
-  e = track([&](int f) { return f < 3 ? 1.2 * reference : 0.9 * reference; }, three);
-  EXPECT_NEAR(e.shape.arm_thickness, 1.2 * shape.height_m / e.shape.height_m, 0.011);
-  // And the options.
+  PoseTracker tracker(cams, {}, three);
+  EXPECT_NEAR(track(tracker, [&](int f, int) { return f < 3 ? 1.2 * reference : 0.9 * reference; }).shape.arm_thickness,
+              1.2, 1e-9);
+  FrameFeatures empty = ModelFeatures(cams, shape, truth, 12);
+  empty.placement.reset();
+  EXPECT_FALSE(tracker.Step(empty, 1.0 / 30).tracking);
+  EXPECT_NEAR(track(tracker, [&](int, int) { return 1.1 * reference; }).shape.arm_thickness, 1.1, 1e-9);
+}
+
+TEST(PoseTracker, ArmThicknessOptionsAreChecked) {
+  PoseTrackerOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.arm_thickness_frames = 0;  // off
+  options.max_arm_thickness = 1.0;   // never thicker
+  options.arm_thickness_min_points = 1;
+  EXPECT_NO_THROW(options.Check());
   for (auto bad : std::vector<std::function<void(PoseTrackerOptions&)>>{
            [](PoseTrackerOptions& o) { o.arm_thickness_frames = -1; },
            [](PoseTrackerOptions& o) { o.arm_thickness_min_points = 0; },

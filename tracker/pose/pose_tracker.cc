@@ -67,7 +67,7 @@ void PoseTrackerOptions::Check() const {
   }
   hull_head.Check();
   if (height_frames < 1) throw std::invalid_argument("pose.height_frames must be at least 1");
-  if (arm_thickness_frames < 0) throw std::invalid_argument("pose.arm_thickness_frames must be at least 0");
+  if (arm_thickness_frames < 0) throw std::invalid_argument("pose.arm_thickness_frames must be non-negative");
   if (arm_thickness_min_points < 1) throw std::invalid_argument("pose.arm_thickness_min_points must be at least 1");
   if (!(arm_reference_diameter > 0)) throw std::invalid_argument("pose.arm_reference_diameter must be positive");
   if (!(max_arm_thickness >= 1)) throw std::invalid_argument("pose.max_arm_thickness must be at least 1");
@@ -166,7 +166,8 @@ void PoseTracker::Initialise(const FrameFeatures& features) {
   girths_.clear();
   arm_diameters_.clear();
   arm_frames_ = 0;
-  shape_ = BodyShape::FromHeight(std::clamp(place.top_m, 1.2, 2.2));
+  arm_diameter_m_ = 0;
+  shape_ = ShapeFor(std::clamp(place.top_m, 1.2, 2.2), 1.0);
   const Vector2d root = place.root.head<2>();
   Vector2d to_screen = facing_xy_;
   std::normal_distribution<double> yaw_noise(0.0, 0.3), pos_noise(0.0, 0.03);
@@ -395,6 +396,14 @@ BodyPose FlippedPose(const BodyPose& pose) {
   return f;
 }
 
+BodyShape PoseTracker::ShapeFor(double height_m, double girth) const {
+  const double thickness =
+      arm_diameter_m_ > 0
+          ? std::clamp(arm_diameter_m_ / (options_.arm_reference_diameter * height_m), 1.0, options_.max_arm_thickness)
+          : 1.0;
+  return BodyShape::FromHeight(height_m, girth, thickness);
+}
+
 void PoseTracker::CapRise(BodyPose* pose) const {
   pose->dof[kDofZ] = std::min(pose->dof[kDofZ], shape_.waist_height_m + options_.max_rise_m);
 }
@@ -556,8 +565,10 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   // What the proposals read of the 3D axis points, once per frame.
   arm_chains_ = ChainArmPoints(features.axis3d);
   torso_xy_.clear();
+  std::vector<double> arm_diameters;  // this frame's, metres
   for (const AxisPoint3d& a : features.axis3d) {
     if (a.part == BodyPart::kTorso) torso_xy_.push_back(a.p_in_world.head<2>());
+    if (a.part == BodyPart::kArm && a.diameter_m > 0) arm_diameters.push_back(a.diameter_m);
   }
 
   std::vector<BodyPose> proposed;
@@ -575,7 +586,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
       const double height = std::clamp(features.placement->top_m, 1.2, 2.2);
       if (std::abs(height / shape_.height_m - 1) > 0.1) {
         const double ratio = height / shape_.height_m;
-        shape_ = BodyShape::FromHeight(height, shape_.girth, shape_.arm_thickness);
+        shape_ = ShapeFor(height, shape_.girth);
         for (BodyPose& p : particles_) p.dof[kDofZ] *= ratio;
         for (BodyPose& p : previous_) p.dof[kDofZ] *= ratio;
       }
@@ -662,7 +673,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
       for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) upright.dof[d] = 0;
       upright.dof[kDofZ] *= top_height / shape_.height_m;
       for (double girth : {0.9, 1.05, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.2, 2.4}) {
-        const double ll = Evaluate(BodyShape::FromHeight(top_height, girth, shape_.arm_thickness), upright, views, nullptr);
+        const double ll = Evaluate(ShapeFor(top_height, girth), upright, views, nullptr);
         if (ll > best_ll) {
           best_ll = ll;
           best_girth = girth;
@@ -672,29 +683,24 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
       girths_.push_back(best_girth);
       const double height = std::clamp(Median(heights_), 1.2, 2.2);
       const double ratio = height / shape_.height_m;
-      shape_ = BodyShape::FromHeight(height, Median(girths_), shape_.arm_thickness);
+      shape_ = ShapeFor(height, Median(girths_));
       for (BodyPose& p : proposed) p.dof[kDofZ] *= ratio;
       for (BodyPose& p : particles_) p.dof[kDofZ] *= ratio;
       out.pose.dof[kDofZ] *= ratio;
     }
   }
-  // Arm thickness: a jacket's sleeves make p5's arms half as thick again as
-  // bare ones, and the model's thinner arms could lie anywhere inside them
-  // (five demos, seeds 1-7: p5's elbows 5.0-5.3 cm, with the arms 1.3 times
-  // as thick 3.8-4.1). The 3D arm axis points measure the arms across; the
-  // girth, measured on the torso, does not tell a jacket from a broad chest.
-  if (out.tracking && arm_frames_ < options_.arm_thickness_frames) {
-    const size_t before = arm_diameters_.size();
-    for (const AxisPoint3d& a : features.axis3d) {
-      if (a.part == BodyPart::kArm && a.diameter_m > 0) arm_diameters_.push_back(a.diameter_m);
-    }
-    if (arm_diameters_.size() > before) {
-      ++arm_frames_;
-      if (static_cast<int>(arm_diameters_.size()) >= options_.arm_thickness_min_points) {
-        const double thickness = std::clamp(
-            Median(arm_diameters_) / (options_.arm_reference_diameter * shape_.height_m), 1.0, options_.max_arm_thickness);
-        shape_ = BodyShape::FromHeight(shape_.height_m, shape_.girth, thickness);
-      }
+  // Arm thickness: p5's jacket sleeves measure a third thicker than bare
+  // arms, and the model's thinner arms could lie anywhere inside them (five
+  // demos, seeds 1-7: p5's elbows 5.0-5.3 cm; with thicker arms 3.9-4.2).
+  // The 3D arm axis points measure the arms across; the girth, measured on
+  // the torso, does not tell a jacket from a broad chest. Kept in metres, so
+  // that a height measured later scales the thickness.
+  if (out.tracking && arm_frames_ < options_.arm_thickness_frames && !arm_diameters.empty()) {
+    arm_diameters_.insert(arm_diameters_.end(), arm_diameters.begin(), arm_diameters.end());
+    ++arm_frames_;
+    if (static_cast<int>(arm_diameters_.size()) >= options_.arm_thickness_min_points) {
+      arm_diameter_m_ = Median(arm_diameters_);
+      shape_ = ShapeFor(shape_.height_m, shape_.girth);
     }
   }
   out.shape = shape_;

@@ -124,9 +124,10 @@ struct PoseTrackerOptions {
   int height_frames = 15;
   // Arm thickness (BodyShape::arm_thickness) from the 3D arm axis points'
   // diameters: their median over the first arm_thickness_frames tracked
-  // frames that have arm points, once arm_thickness_min_points are in,
-  // over arm_reference_diameter times the height; at least 1 (the model's
-  // arms are sized for bare or tight sleeves), at most max_arm_thickness.
+  // frames that have arm points (0 turns the measurement off), once
+  // arm_thickness_min_points are in, over arm_reference_diameter (a fraction
+  // of the height) times the height; at least 1 (the model's arms are sized
+  // for bare or tight sleeves), at most max_arm_thickness.
   int arm_thickness_frames = 150;
   int arm_thickness_min_points = 300;
   double arm_reference_diameter = 0.055;
@@ -189,6 +190,8 @@ class PoseTracker {
   BodyPose TurnedPose(const BodyPose& current, double yaw) const;
   // The waist at most max_rise_m above its standing height.
   void CapRise(BodyPose* pose) const;
+  // The model for a height and girth, its arms as thick as measured.
+  BodyShape ShapeFor(double height_m, double girth) const;
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
   double HeadingPrior(const BodyPose& pose) const;
   bool InView(const Eigen::Vector3d& root) const;
@@ -214,6 +217,7 @@ class PoseTracker {
   std::vector<double> heights_, girths_;
   std::vector<double> arm_diameters_;  // metres, from the 3D arm axis points
   int arm_frames_ = 0;                 // tracked frames that gave them
+  double arm_diameter_m_ = 0;          // their median; 0 until measured
   std::vector<BodyPose> particles_, previous_;
   std::deque<Eigen::Vector2d> recent_roots_;
   // This frame's 3D arm axis points in chains, and torso axis points (x, y).
