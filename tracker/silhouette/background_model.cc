@@ -72,6 +72,12 @@ void BackgroundOptions::Check() const {
   if (!(near_blob_min_fraction >= 0 && near_blob_min_fraction < 1)) {
     throw std::invalid_argument("background near_blob_min_fraction: must be in [0, 1)");
   }
+  if (!(outline_sigma >= 0 && outline_sigma <= 8)) {
+    throw std::invalid_argument("background outline_sigma: must be in [0, 8] (0: no outline refinement)");
+  }
+  if (outline_band < 0 || outline_band > 8) throw std::invalid_argument("background outline_band: must be in [0, 8]");
+  if (!(outline_min_laplacian >= 0)) throw std::invalid_argument("background outline_min_laplacian: must be >= 0");
+  if (!(outline_doubt >= 0)) throw std::invalid_argument("background outline_doubt: must be >= 0");
 }
 
 std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>& frames,
@@ -179,6 +185,24 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     }
     // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
     m.pooled_noise_ = std::max(1e-3, std::sqrt(sum_sq / count * n / dof));
+  }
+  // The outline refinement's noise: z smoothed by its Gaussian, and that
+  // smoothed z's Laplacian.
+  if (flicker && options.outline_sigma > 0) {
+    double smooth_sq = 0, laplacian_sq = 0;
+    size_t count = 0;
+    for (int i = 0; i < n; ++i) {
+      cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
+                               static_cast<float>(m.EstimateScreenGain(frames[i])));
+      cv::Mat smooth, laplacian;
+      cv::GaussianBlur(z.mul(m.sigma_), smooth, cv::Size(), m.OutlineSigmaPx(size.width));
+      cv::Laplacian(smooth, laplacian, CV_32F);
+      smooth_sq += smooth.dot(smooth);
+      laplacian_sq += laplacian.dot(laplacian);
+      count += z.total();
+    }
+    m.smoothed_noise_ = std::max(1e-3, std::sqrt(smooth_sq / count * n / dof));
+    m.outline_noise_ = std::max(1e-3, std::sqrt(laplacian_sq / count * n / dof));
   }
   return m;
 }
@@ -297,11 +321,13 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   }
   r.mask = r.raw.clone();
   const double scale = frame.cols / 320.0;
-  r.blobs_removed = CleanMask(r.mask, static_cast<int>(std::lround(options_.open_radius * scale)),
+  const bool refine = options_.model == "flicker" && options_.outline_sigma > 0;
+  r.blobs_removed = CleanMask(r.mask, refine ? 0 : static_cast<int>(std::lround(options_.open_radius * scale)),
                               static_cast<int>(std::lround(options_.close_radius * scale)),
                               static_cast<int>(options_.min_blob_fraction * frame.total()),
                               static_cast<int>(std::lround(options_.near_blob_px * scale)),
                               static_cast<int>(options_.near_blob_min_fraction * frame.total()));
+  if (refine) RefineOutline(z, r.mask);
   // Darker than the stage, smoothed: within the mask's rows only, where
   // shadow removal reads it. A blur of a view of z reads z's pixels around
   // it, so the values are those of the whole image's blur; the view starts
@@ -317,6 +343,56 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
     r.darker(box).setTo(255, smooth < 0);
   }
   return r;
+}
+
+void BackgroundModel::RefineOutline(const cv::Mat& z, cv::Mat& mask) const {
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return;
+  const double scale = z.cols / 320.0;
+  const double sigma = OutlineSigmaPx(z.cols);
+  // The side of the outline is told by the sign of a wider smoothing of z
+  // (the body brighter or darker than the stage there).
+  const double side_sigma = 2 * sigma;
+  const int band = static_cast<int>(std::lround(options_.outline_band * scale));
+  // Room for the band, the wider Gaussian (3 sigma) and the Laplacian.
+  const int margin = band + static_cast<int>(std::ceil(3 * side_sigma)) + 2;
+  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+                       cv::Rect(0, 0, z.cols, z.rows);
+  // The blur acts on intensities: back from z to grey levels.
+  const cv::Mat difference = z(roi).mul(sigma_(roi));
+  cv::Mat smooth, laplacian, side;
+  cv::GaussianBlur(difference, smooth, cv::Size(), sigma);
+  cv::Laplacian(smooth, laplacian, CV_32F);
+  cv::GaussianBlur(difference, side, cv::Size(), side_sigma);
+  const cv::Mat local = mask(roi);
+  cv::Mat outer, inner;
+  if (band > 0) {
+    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * band + 1, 2 * band + 1));
+    cv::dilate(local, outer, kernel);
+    cv::erode(local, inner, kernel);
+  } else {
+    outer = local.clone();
+    inner = local.clone();
+  }
+  const float min_laplacian = static_cast<float>(options_.outline_min_laplacian * outline_noise_);
+  const float doubt = static_cast<float>(options_.outline_doubt * smoothed_noise_);
+  cv::Mat refined = local.clone();
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* op = outer.ptr<uint8_t>(y);
+    const uint8_t* ip = inner.ptr<uint8_t>(y);
+    const float* sp = smooth.ptr<float>(y);
+    const float* lp = laplacian.ptr<float>(y);
+    const float* dp = side.ptr<float>(y);
+    uint8_t* rp = refined.ptr<uint8_t>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      if (!op[x]) continue;                                   // beyond the band, outside
+      if (ip[x] && std::abs(sp[x]) >= doubt) continue;        // inside, clearly foreground
+      if (std::abs(lp[x]) < min_laplacian) continue;  // no curvature to tell by: left as it is
+      // Inside a blurred step the profile bends away from the stage's level.
+      rp[x] = (dp[x] >= 0 ? lp[x] < 0 : lp[x] > 0) ? 255 : 0;
+    }
+  }
+  refined.copyTo(local);
 }
 
 int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, int near_px, int near_min_area) {
