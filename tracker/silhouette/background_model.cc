@@ -78,6 +78,7 @@ void BackgroundOptions::Check() const {
   if (outline_band < 0 || outline_band > 8) throw std::invalid_argument("background outline_band: must be in [0, 8]");
   if (!(outline_min_laplacian >= 0)) throw std::invalid_argument("background outline_min_laplacian: must be >= 0");
   if (!(outline_doubt >= 0)) throw std::invalid_argument("background outline_doubt: must be >= 0");
+  if (!(outline_max_hole >= 0)) throw std::invalid_argument("background outline_max_hole: must be >= 0");
 }
 
 std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>& frames,
@@ -172,37 +173,38 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
       if (lp[x]) m.light_samples_.push_back({y, x});
     }
   }
-  // The pooled difference's noise, measured where it is used.
-  if (flicker && options.pool_sigma > 0) {
-    double sum_sq = 0;
+  // The noises the thresholds are set in, measured on the training frames:
+  // the pooled z's, and the outline refinement's (the difference I − μ(t)
+  // in grey levels smoothed by its Gaussian, and that smoothed difference's
+  // Laplacian), each one figure for the whole image.
+  const bool pool = flicker && options.pool_sigma > 0, outline = flicker && options.outline_sigma > 0;
+  if (pool || outline) {
+    double pooled_sq = 0, smooth_sq = 0, laplacian_sq = 0;
     size_t count = 0;
     for (int i = 0; i < n; ++i) {
-      cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
-                               static_cast<float>(m.EstimateScreenGain(frames[i])));
-      cv::GaussianBlur(z, z, cv::Size(), m.PoolSigmaPx(size.width));
-      sum_sq += z.dot(z);
+      const cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
+                                     static_cast<float>(m.EstimateScreenGain(frames[i])));
+      if (pool) {
+        cv::Mat pooled;
+        cv::GaussianBlur(z, pooled, cv::Size(), m.PoolSigmaPx(size.width));
+        pooled_sq += pooled.dot(pooled);
+      }
+      if (outline) {
+        cv::Mat smooth, laplacian;
+        cv::GaussianBlur(z.mul(m.sigma_), smooth, cv::Size(), m.OutlineSigmaPx(size.width));
+        cv::Laplacian(smooth, laplacian, CV_32F);
+        smooth_sq += smooth.dot(smooth);
+        laplacian_sq += laplacian.dot(laplacian);
+      }
       count += z.total();
     }
     // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
-    m.pooled_noise_ = std::max(1e-3, std::sqrt(sum_sq / count * n / dof));
-  }
-  // The outline refinement's noise: z smoothed by its Gaussian, and that
-  // smoothed z's Laplacian.
-  if (flicker && options.outline_sigma > 0) {
-    double smooth_sq = 0, laplacian_sq = 0;
-    size_t count = 0;
-    for (int i = 0; i < n; ++i) {
-      cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
-                               static_cast<float>(m.EstimateScreenGain(frames[i])));
-      cv::Mat smooth, laplacian;
-      cv::GaussianBlur(z.mul(m.sigma_), smooth, cv::Size(), m.OutlineSigmaPx(size.width));
-      cv::Laplacian(smooth, laplacian, CV_32F);
-      smooth_sq += smooth.dot(smooth);
-      laplacian_sq += laplacian.dot(laplacian);
-      count += z.total();
+    const auto rms = [&](double sum_sq) { return std::max(1e-3, std::sqrt(sum_sq / count * n / dof)); };
+    if (pool) m.pooled_noise_ = rms(pooled_sq);
+    if (outline) {
+      m.smoothed_noise_ = rms(smooth_sq);
+      m.outline_noise_ = rms(laplacian_sq);
     }
-    m.smoothed_noise_ = std::max(1e-3, std::sqrt(smooth_sq / count * n / dof));
-    m.outline_noise_ = std::max(1e-3, std::sqrt(laplacian_sq / count * n / dof));
   }
   return m;
 }
@@ -327,7 +329,13 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
                               static_cast<int>(options_.min_blob_fraction * frame.total()),
                               static_cast<int>(std::lround(options_.near_blob_px * scale)),
                               static_cast<int>(options_.near_blob_min_fraction * frame.total()));
-  if (refine) RefineOutline(z, r.mask);
+  if (refine) {
+    RefineOutline(z, r.mask);
+    // Parts the refinement cut off, small: dropped as the blobs above.
+    r.blobs_removed += CleanMask(r.mask, 0, 0, static_cast<int>(options_.min_blob_fraction * frame.total()),
+                                 static_cast<int>(std::lround(options_.near_blob_px * scale)),
+                                 static_cast<int>(options_.near_blob_min_fraction * frame.total()));
+  }
   // Darker than the stage, smoothed: within the mask's rows only, where
   // shadow removal reads it. A blur of a view of z reads z's pixels around
   // it, so the values are those of the whole image's blur; the view starts
@@ -350,21 +358,22 @@ void BackgroundModel::RefineOutline(const cv::Mat& z, cv::Mat& mask) const {
   if (box.empty()) return;
   const double scale = z.cols / 320.0;
   const double sigma = OutlineSigmaPx(z.cols);
-  // The side of the outline is told by the sign of a wider smoothing of z
-  // (the body brighter or darker than the stage there).
+  // The side of the outline is told by the sign of a wider smoothing of the
+  // difference (the body brighter or darker than the stage there).
   const double side_sigma = 2 * sigma;
   const int band = static_cast<int>(std::lround(options_.outline_band * scale));
-  // Room for the band, the wider Gaussian (3 sigma) and the Laplacian.
-  const int margin = band + static_cast<int>(std::ceil(3 * side_sigma)) + 2;
+  // Room for the band, the wider Gaussian (OpenCV's float kernels reach 4
+  // sigma) and the Laplacian, so that every value read is the whole image's.
+  const int margin = band + static_cast<int>(std::ceil(4 * side_sigma)) + 2;
   const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
                        cv::Rect(0, 0, z.cols, z.rows);
-  // The blur acts on intensities: back from z to grey levels.
+  // The blur acts on intensities: back from z to grey levels, I − μ(t).
   const cv::Mat difference = z(roi).mul(sigma_(roi));
   cv::Mat smooth, laplacian, side;
   cv::GaussianBlur(difference, smooth, cv::Size(), sigma);
   cv::Laplacian(smooth, laplacian, CV_32F);
   cv::GaussianBlur(difference, side, cv::Size(), side_sigma);
-  const cv::Mat local = mask(roi);
+  cv::Mat local = mask(roi);  // a view: written back at the end
   cv::Mat outer, inner;
   if (band > 0) {
     const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * band + 1, 2 * band + 1));
@@ -385,11 +394,37 @@ void BackgroundModel::RefineOutline(const cv::Mat& z, cv::Mat& mask) const {
     const float* dp = side.ptr<float>(y);
     uint8_t* rp = refined.ptr<uint8_t>(y);
     for (int x = 0; x < roi.width; ++x) {
-      if (!op[x]) continue;                                   // beyond the band, outside
-      if (ip[x] && std::abs(sp[x]) >= doubt) continue;        // inside, clearly foreground
-      if (std::abs(lp[x]) < min_laplacian) continue;  // no curvature to tell by: left as it is
+      if (!op[x]) continue;                             // beyond the band, outside
+      if (ip[x] && std::abs(sp[x]) >= doubt) continue;  // inside, clearly foreground
+      if (std::abs(lp[x]) < min_laplacian) continue;    // no curvature to tell by: left as it is
       // Inside a blurred step the profile bends away from the stage's level.
       rp[x] = (dp[x] >= 0 ? lp[x] < 0 : lp[x] > 0) ? 255 : 0;
+    }
+  }
+  // Holes the refinement opened inside the mask (wholly within it before),
+  // small: the Laplacian's noise where the body's own brightness varies.
+  // Larger ones are gaps the closing had filled.
+  const int max_hole = static_cast<int>(std::lround(options_.outline_max_hole * scale * scale));
+  if (max_hole > 0) {
+    cv::Mat labels;
+    const cv::Mat background = refined == 0;
+    const int count = cv::connectedComponents(background, labels, 4, CV_32S);
+    std::vector<int> area(count, 0);
+    std::vector<uint8_t> outside(count, 0);  // holds a pixel outside the mask before
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* lp = labels.ptr<int>(y);
+      const uint8_t* mp = local.ptr<uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) {
+        ++area[lp[x]];
+        if (!mp[x]) outside[lp[x]] = 1;
+      }
+    }
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* lp = labels.ptr<int>(y);
+      uint8_t* rp = refined.ptr<uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) {
+        if (lp[x] > 0 && !outside[lp[x]] && area[lp[x]] <= max_hole) rp[x] = 255;
+      }
     }
   }
   refined.copyTo(local);

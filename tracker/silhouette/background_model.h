@@ -57,18 +57,26 @@ struct BackgroundOptions {
   double near_blob_px = 10;
   double near_blob_min_fraction = 0.0003;
   // Outline refinement (flicker model): the lens blurs the body's outline
-  // over a few pixels, and every pixel the blur lifts over the thresholds is
-  // foreground, so the silhouette grows a pixel all round. The outline is
-  // moved to the blurred edge's inflection — where the Laplacian of the
-  // smoothed difference changes sign, which blur does not move — for the
-  // pixels within `outline_band` px (at 320x240) of it and for the doubtful
-  // ones inside (the smoothed difference under `outline_doubt` times its
-  // noise: gaps a closing filled). Pixels whose Laplacian is under
-  // `outline_min_laplacian` times its noise keep their label. Off: 0 sigma.
-  double outline_sigma = 0.8;  // px at 320x240: the Gaussian before the Laplacian
+  // over a few pixels, and the pooled evidence finds the blur's faint tail,
+  // so the silhouette grows a pixel all round. The outline is moved towards
+  // the blurred edge's inflection, where the Laplacian of the smoothed
+  // difference I − μ(t) (grey levels, Gaussian of `outline_sigma` px at
+  // 320x240) changes sign: a pixel is inside where the Laplacian bends away
+  // from the stage's level. Decided so: the pixels within `outline_band` px
+  // of the outline, and those inside whose smoothed difference is under
+  // `outline_doubt` times its noise (foreground only the pooling found, gaps
+  // the closing filled). Pixels whose Laplacian is under
+  // `outline_min_laplacian` times its noise keep their label (both noises
+  // measured on the empty-stage frames, one figure per image). Holes this
+  // opens inside the mask of up to `outline_max_hole` pixels (at 320x240)
+  // are noise and filled; parts it cuts off go by the blob rules above. One
+  // pass: where the mask was two pixels too wide, it stays one too wide
+  // (straight blurred edges in background_model_test). 0 sigma: off.
+  double outline_sigma = 0.8;
   int outline_band = 1;
   double outline_min_laplacian = 2.5;
   double outline_doubt = 16;
+  double outline_max_hole = 8;
   // Throws std::invalid_argument naming the option.
   void Check() const;
 };
@@ -125,8 +133,10 @@ class BackgroundModel {
   cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;
   double pooled_noise_ = 1;  // std of the pooled z on the training frames
-  double outline_noise_ = 1;    // std of the outline's Laplacian of z on the training frames
-  double smoothed_noise_ = 1;   // std of z smoothed by outline_sigma on the training frames
+  // On the training frames, grey levels: the rms of I − μ(t) smoothed by
+  // outline_sigma, and of that smoothed difference's Laplacian.
+  double smoothed_noise_ = 1;
+  double outline_noise_ = 1;
   double OutlineSigmaPx(int width) const { return options_.outline_sigma * width / 320.0; }
   // Moves `mask`'s outline to the inflection of the blurred edge (see
   // BackgroundOptions::outline_sigma).
