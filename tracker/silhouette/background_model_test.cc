@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -228,6 +229,36 @@ TEST(BackgroundModelTest, NoisyTrainingStillFollowsAFlash) {
   EXPECT_LT(levels[2], levels[0] - 3);
 }
 
+// A stage with the thesis preset's grain (as the background model measures
+// it there) and two models of it, with and without the outline refinement;
+// Frame() puts a body's radiance (grey levels over the stage) on it.
+struct RefinementBench {
+  static constexpr float kNoise = 0.4f;
+  SyntheticStage stage;
+  std::optional<BackgroundModel> refined, unrefined;
+  RefinementBench() {
+    std::vector<cv::Mat> training;
+    std::uniform_real_distribution<double> level(40, 60);
+    for (int i = 0; i < 12; ++i) training.push_back(stage.Frame(level(stage.rng), kNoise));
+    BackgroundOptions unrefined_options;
+    unrefined_options.outline_sigma = 0;
+    refined = BackgroundModel::Train(training, {});
+    unrefined = BackgroundModel::Train(training, unrefined_options);
+  }
+  cv::Mat Frame(const cv::Mat& body, double light) {
+    std::normal_distribution<float> noise(0.0f, kNoise);
+    cv::Mat frame(240, 320, CV_8U);
+    for (int y = 0; y < 240; ++y) {
+      for (int x = 0; x < 320; ++x) {
+        const float v = stage.a.at<float>(y, x) + stage.b.at<float>(y, x) * float(light) + body.at<float>(y, x) +
+                        noise(stage.rng);
+        frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(std::lround(v));
+      }
+    }
+    return frame;
+  }
+};
+
 // A lens blurs the outline over a few pixels, and the thresholds take every
 // pixel the blur lifts over them: the silhouette grows all round. The
 // refinement moves the outline to the blurred edge's inflection. The person —
@@ -236,17 +267,8 @@ TEST(BackgroundModelTest, NoisyTrainingStillFollowsAFlash) {
 // lit from the camera's side; the truth is coverage >= 50%, as the
 // renderer's masks.
 TEST(BackgroundModelTest, OutlineRefinementFindsTheBlurredEdge) {
-  // The thesis preset's grain, as the background model measures it there.
-  constexpr float kNoise = 0.4f;
-  SyntheticStage stage;
-  std::vector<cv::Mat> training;
-  std::uniform_real_distribution<double> level(40, 60);
-  for (int i = 0; i < 12; ++i) training.push_back(stage.Frame(level(stage.rng), kNoise));
-  BackgroundOptions unrefined_options;
-  unrefined_options.outline_sigma = 0;
-  const auto refined = BackgroundModel::Train(training, {});
-  const auto unrefined = BackgroundModel::Train(training, unrefined_options);
-  ASSERT_TRUE(refined && unrefined);
+  RefinementBench bench;
+  ASSERT_TRUE(bench.refined && bench.unrefined);
 
   constexpr int kSub = 4;
   cv::Mat inside = cv::Mat::zeros(240 * kSub, 320 * kSub, CV_32F), shaded = inside.clone();
@@ -272,19 +294,11 @@ TEST(BackgroundModelTest, OutlineRefinementFindsTheBlurredEdge) {
   cv::resize(shaded, body, cv::Size(320, 240), 0, 0, cv::INTER_AREA);
   const cv::Mat truth = coverage >= 0.5;
   cv::GaussianBlur(body * 14.0, body, cv::Size(), 1.3);  // the defocus
-  std::normal_distribution<float> noise(0.0f, kNoise);
   for (const double light : {45.0, 55.0}) {
-    cv::Mat frame(240, 320, CV_8U);
-    for (int y = 0; y < 240; ++y) {
-      for (int x = 0; x < 320; ++x) {
-        const float v = stage.a.at<float>(y, x) + stage.b.at<float>(y, x) * float(light) + body.at<float>(y, x) +
-                        noise(stage.rng);
-        frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(std::lround(v));
-      }
-    }
-    const cv::Mat mask = refined->Segment(frame).mask;
+    const cv::Mat frame = bench.Frame(body, light);
+    const cv::Mat mask = bench.refined->Segment(frame).mask;
     const double with = IoU(mask, truth);
-    const double without = IoU(unrefined->Segment(frame).mask, truth);
+    const double without = IoU(bench.unrefined->Segment(frame).mask, truth);
     std::printf("light %.0f: silhouette IoU %.3f refined, %.3f without\n", light, with, without);
     // Measured: 0.898 and 0.890 refined, 0.850 and 0.848 without.
     EXPECT_GT(with, 0.88) << "light " << light;
@@ -304,16 +318,8 @@ TEST(BackgroundModelTest, OutlineRefinementFindsTheBlurredEdge) {
 // pass takes one off. The body's right edge is at x = 100.3: pixels up to
 // column 100 are more than half covered.
 TEST(BackgroundModelTest, RefinedOutlineDoesNotGrowWithTheContrast) {
-  constexpr float kNoise = 0.4f;
-  SyntheticStage stage;
-  std::vector<cv::Mat> training;
-  std::uniform_real_distribution<double> level(40, 60);
-  for (int i = 0; i < 12; ++i) training.push_back(stage.Frame(level(stage.rng), kNoise));
-  BackgroundOptions unrefined_options;
-  unrefined_options.outline_sigma = 0;
-  const auto refined = BackgroundModel::Train(training, {});
-  const auto unrefined = BackgroundModel::Train(training, unrefined_options);
-  ASSERT_TRUE(refined && unrefined);
+  RefinementBench bench;
+  ASSERT_TRUE(bench.refined && bench.unrefined);
   cv::Mat coverage = cv::Mat::zeros(240, 320, CV_32F);
   for (int y = 60; y < 180; ++y) {
     for (int x = 40; x <= 101; ++x) {
@@ -321,18 +327,11 @@ TEST(BackgroundModelTest, RefinedOutlineDoesNotGrowWithTheContrast) {
       coverage.at<float>(y, x) = float(std::clamp(std::min(x + 0.5, 100.3) - std::max(x - 0.5, 40.3), 0.0, 1.0));
     }
   }
-  std::normal_distribution<float> noise(0.0f, kNoise);
   std::vector<double> with, without;
   for (const double contrast : {6.0, 24.0}) {
     cv::Mat body;
     cv::GaussianBlur(coverage * contrast, body, cv::Size(), 1.3);
-    cv::Mat frame(240, 320, CV_8U);
-    for (int y = 0; y < 240; ++y) {
-      for (int x = 0; x < 320; ++x) {
-        const float v = stage.a.at<float>(y, x) + stage.b.at<float>(y, x) * 50.0f + body.at<float>(y, x) + noise(stage.rng);
-        frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(std::lround(v));
-      }
-    }
+    const cv::Mat frame = bench.Frame(body, 50.0);
     // The mean over rows of the last silhouette column, less the true one (100).
     const auto offset = [&](const cv::Mat& mask) {
       double sum = 0;
@@ -344,8 +343,8 @@ TEST(BackgroundModelTest, RefinedOutlineDoesNotGrowWithTheContrast) {
       }
       return sum / rows;
     };
-    with.push_back(offset(refined->Segment(frame).mask));
-    without.push_back(offset(unrefined->Segment(frame).mask));
+    with.push_back(offset(bench.refined->Segment(frame).mask));
+    without.push_back(offset(bench.unrefined->Segment(frame).mask));
     std::printf("contrast %.0f: the right edge %+.2f px off refined, %+.2f px without\n", contrast, with.back(),
                 without.back());
     EXPECT_GE(with.back(), -0.2) << "contrast " << contrast;
