@@ -324,17 +324,16 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   r.mask = r.raw.clone();
   const double scale = frame.cols / 320.0;
   const bool refine = options_.model == "flicker" && options_.outline_sigma > 0;
+  const int min_area = static_cast<int>(options_.min_blob_fraction * frame.total());
+  const int near_px = static_cast<int>(std::lround(options_.near_blob_px * scale));
+  const int near_min_area = static_cast<int>(options_.near_blob_min_fraction * frame.total());
   r.blobs_removed = CleanMask(r.mask, refine ? 0 : static_cast<int>(std::lround(options_.open_radius * scale)),
-                              static_cast<int>(std::lround(options_.close_radius * scale)),
-                              static_cast<int>(options_.min_blob_fraction * frame.total()),
-                              static_cast<int>(std::lround(options_.near_blob_px * scale)),
-                              static_cast<int>(options_.near_blob_min_fraction * frame.total()));
+                              static_cast<int>(std::lround(options_.close_radius * scale)), min_area, near_px,
+                              near_min_area);
   if (refine) {
     RefineOutline(z, r.mask);
     // Parts the refinement cut off, small: dropped as the blobs above.
-    r.blobs_removed += CleanMask(r.mask, 0, 0, static_cast<int>(options_.min_blob_fraction * frame.total()),
-                                 static_cast<int>(std::lround(options_.near_blob_px * scale)),
-                                 static_cast<int>(options_.near_blob_min_fraction * frame.total()));
+    r.blobs_removed += CleanMask(r.mask, 0, 0, min_area, near_px, near_min_area);
   }
   // Darker than the stage, smoothed: within the mask's rows only, where
   // shadow removal reads it. A blur of a view of z reads z's pixels around
@@ -374,15 +373,11 @@ void BackgroundModel::RefineOutline(const cv::Mat& z, cv::Mat& mask) const {
   cv::Laplacian(smooth, laplacian, CV_32F);
   cv::GaussianBlur(difference, side, cv::Size(), side_sigma);
   cv::Mat local = mask(roi);  // a view: written back at the end
+  // The band about the outline (band 0: a 1x1 kernel, the mask itself).
   cv::Mat outer, inner;
-  if (band > 0) {
-    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * band + 1, 2 * band + 1));
-    cv::dilate(local, outer, kernel);
-    cv::erode(local, inner, kernel);
-  } else {
-    outer = local.clone();
-    inner = local.clone();
-  }
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * band + 1, 2 * band + 1));
+  cv::dilate(local, outer, kernel);
+  cv::erode(local, inner, kernel);
   const float min_laplacian = static_cast<float>(options_.outline_min_laplacian * outline_noise_);
   const float doubt = static_cast<float>(options_.outline_doubt * smoothed_noise_);
   cv::Mat refined = local.clone();
