@@ -157,8 +157,9 @@ int main(int argc, char** argv) {
   std::string score_sequence, score_track, score_out;
   CLI::App* score_cmd = app.add_subcommand(
       "score", "Score a track file against the sequence's truth: the thesis's tables (joint errors with\n"
-               "Chauvenet outliers, pointing angles, rest state, motion labels) as JSON, Markdown and CSV,\n"
-               "and report.html: the tables, plots and a frame viewer with the truth and the track drawn over\n"
+               "Chauvenet outliers, pointing angles, rest state, motion labels; the silhouettes' IoU per camera\n"
+               "when irbench track's silhouettes/ lie beside the track file) as JSON, Markdown and CSV, and\n"
+               "report.html: the tables, plots and a frame viewer with the truth and the track drawn over\n"
                "every camera's image, worst frames first");
   score_cmd->add_option("SEQ", score_sequence, "sequence folder written by render")->required();
   score_cmd->add_option("--track", score_track, "track.jsonl to score (default: SEQ/track/track.jsonl)");

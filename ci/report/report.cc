@@ -124,6 +124,29 @@ std::string Tables(const Score& score) {
     }
     out << "</table>\n";
   }
+  if (score.silhouettes) {
+    const SilhouetteScore& sil = *score.silhouettes;
+    out << "<h3>Silhouettes against the truth masks <small>(camera-frames with the person in the truth mask; "
+           "false foreground and missed body pixels as a share of the true body's; near the outline: the share "
+           "of those errors within one pixel of the true outline)</small></h3>\n<table id=\"silhouettes\">"
+        << "<tr><th>Camera</th><th>Frames</th><th>IoU median</th><th>IoU p10</th><th>False</th><th>Missed</th>"
+           "<th>Near the outline</th></tr>\n";
+    const auto row = [&](const std::string& name, const SilhouetteSummary& s) {
+      const auto cell = [&](const std::string& v) { return "<td>" + (s.camera_frames ? v : std::string("–")) + "</td>"; };
+      out << "<tr><th>" << Escape(name) << "</th><td>" << s.camera_frames << "</td>" << cell(Fixed(s.iou_median, 3))
+          << cell(Fixed(s.iou_p10, 3)) << cell(Fixed(100 * s.false_share, 1) + " %")
+          << cell(Fixed(100 * s.missed_share, 1) + " %") << cell(Fixed(100 * s.near_outline_share, 0) + " %")
+          << "</tr>\n";
+    };
+    for (const auto& [camera, s] : sil.ByCamera()) row(camera, s);
+    row("All", sil.All());
+    out << "</table>\n";
+    if (sil.empty_frames) {
+      out << "<p>" << sil.empty_frames << " camera-frames without the person in view: " << sil.empty_false
+          << " silhouette pixels there.</p>\n";
+    }
+    if (sil.missing) out << "<p>" << sil.missing << " camera-frames have a truth mask but no silhouette.</p>\n";
+  }
   return out.str();
 }
 

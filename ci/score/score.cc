@@ -295,6 +295,7 @@ nlohmann::json Score::ToJson() const {
                         {"total", motion.total},
                         {"missing", motion.missing},
                         {"confusion", motion_confusion}};
+  j["silhouettes"] = silhouettes ? silhouettes->ToJson() : Json(nullptr);
   return j;
 }
 
@@ -350,6 +351,7 @@ std::string Score::Markdown() const {
       out << "\n";
     }
   }
+  if (silhouettes) out << "\n" << silhouettes->Markdown();
   return out.str();
 }
 

@@ -20,6 +20,8 @@
 #include <tuple>
 #include <vector>
 
+#include "ci/score/silhouette_score.h"
+
 namespace irbench {
 
 // Chauvenet's criterion, one pass: sample i is an outlier when
@@ -72,6 +74,9 @@ struct Score {
   // Motion labels: truth label -> tracked label -> count, both arms together.
   std::map<std::string, std::map<std::string, int>> motion_confusion;
   Accuracy motion;
+  // The tracker's silhouettes against the truth masks, when the track folder
+  // has them (irbench track writes silhouettes/ beside track.jsonl).
+  std::optional<SilhouetteScore> silhouettes;
 
   nlohmann::json ToJson() const;
   // The tables as GitHub-flavoured Markdown.

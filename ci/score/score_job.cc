@@ -29,7 +29,12 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score
   if (!fs::is_regular_file(track)) {
     throw InputError(track.string(), "--track", "no such track file (irbench track writes one; or give --track)");
   }
-  const Score score = ScoreTrack(truth, track, options.score);
+  Score score = ScoreTrack(truth, track, options.score);
+  // The silhouettes irbench track writes beside its track file, against the
+  // truth masks.
+  const fs::path silhouettes = track.parent_path() / "silhouettes";
+  const fs::path masks = options.sequence / "truth" / "masks";
+  if (fs::is_directory(silhouettes) && fs::is_directory(masks)) score.silhouettes = ScoreSilhouettes(masks, silhouettes);
   const fs::path out = options.out.empty() ? options.sequence / "score" : options.out;
   StagingDir staging(out, options.overwrite, "--out");
   nlohmann::json j = score.ToJson();
@@ -62,6 +67,7 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score
     }
   }
   AtomicWriteFile(staging.path() / "errors.csv", errors_csv.str());
+  if (score.silhouettes) AtomicWriteFile(staging.path() / "silhouettes.csv", score.silhouettes->Csv());
   if (options.report) {
     ReportOptions report;
     report.sequence = options.sequence;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 
 #include "common/error.h"
@@ -164,6 +165,79 @@ TEST_F(ScoreTest, ReportsExactlyTheInjectedErrors) {
   EXPECT_NE(md.find("| Right Elbow | 3.00 | 0.00 | 0 |"), std::string::npos) << md;
   EXPECT_NE(irbench::testing::ReadText(out / "tables.md").find("Table 6.3"), std::string::npos);
   EXPECT_NE(irbench::testing::ReadText(out / "joints.csv").find("right_elbow,3,"), std::string::npos);
+}
+
+// irbench track's silhouettes/ beside the track file are scored against the
+// truth masks: copies of the masks score IoU 1, and one camera's masks moved a
+// pixel to the right score exactly what the move made, all of it within a
+// pixel of the true outline.
+TEST_F(ScoreTest, SilhouettesBesideTheTrackAreScored) {
+  std::vector<Json> track;
+  for (const Json& t : truth_) track.push_back(Perfect(t));
+  const fs::path folder = dir_ / "with_silhouettes";
+  fs::create_directories(folder);
+  Write(folder / "track.jsonl", track);
+  const fs::path masks = dir_ / "seq/truth/masks";
+  std::string moved_camera;
+  long moved_truth = 0, moved_false = 0, moved_missed = 0;
+  int scored = 0;
+  for (const auto& camera : fs::directory_iterator(masks)) {
+    const std::string name = camera.path().filename().string();
+    if (moved_camera.empty()) moved_camera = name;
+    fs::create_directories(folder / "silhouettes" / name);
+    for (const auto& file : fs::directory_iterator(camera.path())) {
+      cv::Mat mask = cv::imread(file.path().string(), cv::IMREAD_GRAYSCALE);
+      ASSERT_FALSE(mask.empty());
+      if (cv::countNonZero(mask) > 0) ++scored;
+      if (name == moved_camera) {
+        cv::Mat moved = cv::Mat::zeros(mask.size(), CV_8U);
+        mask.colRange(0, mask.cols - 1).copyTo(moved.colRange(1, mask.cols));
+        moved_truth += cv::countNonZero(mask);
+        moved_false += cv::countNonZero(moved & ~mask);
+        moved_missed += cv::countNonZero(mask & ~moved);
+        mask = moved;
+      }
+      cv::imwrite((folder / "silhouettes" / name / file.path().filename()).string(), mask);
+    }
+  }
+  ASSERT_GT(moved_truth, 0);
+  ScoreJobOptions job;
+  job.sequence = dir_ / "seq";
+  job.track = folder / "track.jsonl";
+  job.out = dir_ / "score_silhouettes";
+  Score s;
+  const fs::path out = RunScoreJob(job, nullptr, &s);
+  ASSERT_TRUE(s.silhouettes);
+  EXPECT_EQ(int(s.silhouettes->frames.size()), scored);
+  EXPECT_EQ(s.silhouettes->missing, 0);
+  for (const auto& [camera, summary] : s.silhouettes->ByCamera()) {
+    if (camera == moved_camera) {
+      EXPECT_LT(summary.iou_median, 1.0);
+      EXPECT_DOUBLE_EQ(summary.false_share, double(moved_false) / moved_truth);
+      EXPECT_DOUBLE_EQ(summary.missed_share, double(moved_missed) / moved_truth);
+      EXPECT_DOUBLE_EQ(summary.near_outline_share, 1.0);
+    } else {
+      EXPECT_DOUBLE_EQ(summary.iou_min, 1.0) << camera;
+      EXPECT_DOUBLE_EQ(summary.false_share + summary.missed_share, 0.0) << camera;
+    }
+  }
+  const Json j = Json::parse(irbench::testing::ReadText(out / "score.json"));
+  EXPECT_EQ(j["silhouettes"]["camera_frames"], scored);
+  EXPECT_NE(irbench::testing::ReadText(out / "tables.md").find("| All | " + std::to_string(scored) + " |"),
+            std::string::npos);
+  EXPECT_TRUE(fs::is_regular_file(out / "silhouettes.csv"));
+  const std::string page = irbench::testing::ReadText(out / "report.html");
+  EXPECT_NE(page.find("<table id=\"silhouettes\">"), std::string::npos);
+  EXPECT_NE(page.find("<tr><th>All</th><td>" + std::to_string(scored) + "</td>"), std::string::npos);
+  // A track without silhouettes beside it: none scored, none invented.
+  Write(dir_ / "plain.jsonl", track);
+  job.track = dir_ / "plain.jsonl";
+  job.out = dir_ / "score_plain";
+  job.report = false;
+  const fs::path plain = RunScoreJob(job, nullptr, &s);
+  EXPECT_FALSE(s.silhouettes);
+  EXPECT_TRUE(Json::parse(irbench::testing::ReadText(plain / "score.json"))["silhouettes"].is_null());
+  EXPECT_FALSE(fs::exists(plain / "silhouettes.csv"));
 }
 
 TEST_F(ScoreTest, BadTrackFilesNameTheLine) {

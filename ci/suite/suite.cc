@@ -8,7 +8,6 @@
 #include <mutex>
 #include <thread>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <fstream>
 #include <sstream>
 
@@ -143,23 +142,6 @@ std::string CacheKey(const RenderJobOptions& r) {
   return hex;
 }
 
-double MedianSilhouetteIoU(const fs::path& seq, const fs::path& track) {
-  std::vector<double> ious;
-  for (const auto& cam : fs::directory_iterator(seq / "truth" / "masks")) {
-    for (const auto& f : fs::directory_iterator(cam.path())) {
-      const cv::Mat truth = cv::imread(f.path().string(), cv::IMREAD_GRAYSCALE);
-      const cv::Mat sil = cv::imread((track / "silhouettes" / cam.path().filename() / f.path().filename()).string(),
-                                     cv::IMREAD_GRAYSCALE);
-      if (truth.empty() || sil.empty() || cv::countNonZero(truth) == 0) continue;
-      const int u = cv::countNonZero(truth | sil);
-      ious.push_back(double(cv::countNonZero(truth & sil)) / u);
-    }
-  }
-  if (ious.empty()) return 0;
-  std::sort(ious.begin(), ious.end());
-  return ious[ious.size() / 2];
-}
-
 // What one scenario measured, in the order of its thresholds.
 std::map<std::string, double> RunScenario(const Scenario& sc, const std::string& suite, const fs::path& cache,
                                           std::mutex* render_mutex, fs::path* report) {
@@ -197,7 +179,7 @@ std::map<std::string, double> RunScenario(const Scenario& sc, const std::string&
   Score score;
   *report = RunScoreJob(job, nullptr, &score) / "report.html";
   std::map<std::string, double> metrics;
-  metrics["silhouette_iou_median"] = MedianSilhouetteIoU(seq, track.out);
+  metrics["silhouette_iou_median"] = score.silhouettes ? score.silhouettes->All().iou_median : 0.0;
   metrics["tracked_fraction"] = score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
   double arms = 0;
   int arm_joints = 0;
