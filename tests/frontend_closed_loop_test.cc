@@ -250,13 +250,14 @@ TEST(FrontendClosedLoopTest, VoxelHullFromThesisSilhouettes) {
   std::printf("voxel hull from thesis-preset silhouettes: containment median %.1f%%, volume ratio median %.2f; "
               "one view may miss: %.1f%%, %.2f\n",
               100 * Median(containment), Median(ratio), 100 * Median(containment_tolerant), Median(ratio_tolerant));
-  // Floors under today's figures (79.3%, 1.35x; tolerant 93.8%, 2.95x). The
+  // Floors under today's figures (94.2%, 1.47x; tolerant 99.9%, 3.50x;
+  // before the outline refinement 79.3%, 1.35x and 93.8%, 2.95x). The
   // issue's bars (98%, at most 2x) are met on the truth masks
   // (tracker/hull/hull_closed_loop_test.cc), not yet on the tracker's own
   // silhouettes: a body part one camera loses is carved away.
-  EXPECT_GE(Median(containment), 0.72);
+  EXPECT_GE(Median(containment), 0.9);
   EXPECT_LE(Median(ratio), 2.0);
-  EXPECT_GE(Median(containment_tolerant), 0.9);
+  EXPECT_GE(Median(containment_tolerant), 0.97);
   EXPECT_GT(Median(containment_tolerant), Median(containment));
 }
 

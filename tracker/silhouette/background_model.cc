@@ -198,12 +198,32 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
       }
       count += z.total();
     }
+    // Floors: what 8-bit rounding alone gives after the same filters (white
+    // noise of 1/√12 grey levels a pixel; in z, over the floor of σ). Frames
+    // without noise (the `clean` preset) would otherwise set the thresholds
+    // at a thousandth of a grey level, and the faintest tail of the blurred
+    // outline would join the body.
+    const auto filtered_norm = [&](double sigma, bool laplacian) {
+      const int half = static_cast<int>(std::ceil(5 * sigma)) + 2;
+      cv::Mat delta = cv::Mat::zeros(2 * half + 1, 2 * half + 1, CV_32F), out;
+      delta.at<float>(half, half) = 1;
+      cv::GaussianBlur(delta, out, cv::Size(), sigma);
+      if (laplacian) cv::Laplacian(out, out, CV_32F);
+      return std::sqrt(out.dot(out));
+    };
+    const double rounding = 1 / std::sqrt(12.0);
     // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
-    const auto rms = [&](double sum_sq) { return std::max(1e-3, std::sqrt(sum_sq / count * n / dof)); };
-    if (pool) m.pooled_noise_ = rms(pooled_sq);
+    const auto rms = [&](double sum_sq, double floor) {
+      return std::max(floor, std::sqrt(sum_sq / count * n / dof));
+    };
+    if (pool) {
+      const double floor = filtered_norm(m.PoolSigmaPx(size.width), false) * rounding / options.min_sigma;
+      m.pooled_noise_ = rms(pooled_sq, floor);
+    }
     if (outline) {
-      m.smoothed_noise_ = rms(smooth_sq);
-      m.outline_noise_ = rms(laplacian_sq);
+      const double sigma = m.OutlineSigmaPx(size.width);
+      m.smoothed_noise_ = rms(smooth_sq, filtered_norm(sigma, false) * rounding);
+      m.outline_noise_ = rms(laplacian_sq, filtered_norm(sigma, true) * rounding);
     }
   }
   return m;

@@ -44,7 +44,11 @@ struct BackgroundOptions {
   int open_radius = 1;
   int close_radius = 2;
   // Flicker model: the pooling window (Gaussian sigma, px at 320x240; 0: off)
-  // and the threshold on the pooled difference, in units of its own noise.
+  // and the threshold on the pooled difference, in units of its own noise —
+  // measured on the empty-stage frames, and no lower than 8-bit rounding
+  // alone makes it (1/√12 grey levels a pixel): empty-stage frames without
+  // noise (the `clean` preset) would put the thresholds at nothing, and the
+  // faintest tail of a blurred outline would join the body.
   double pool_sigma = 0.8;
   double pool_threshold = 6.0;
   double pool_weak_threshold = 3.0;  // hysteresis: weaker evidence joined to strong
@@ -67,7 +71,8 @@ struct BackgroundOptions {
   // `outline_doubt` times its noise (foreground only the pooling found, gaps
   // the closing filled). Pixels whose Laplacian is under
   // `outline_min_laplacian` times its noise keep their label (both noises
-  // measured on the empty-stage frames, one figure per image). Holes this
+  // measured on the empty-stage frames, one figure per image, and no lower
+  // than 8-bit rounding alone makes them: see `pool_threshold`). Holes this
   // opens inside the mask of up to `outline_max_hole` pixels (at 320x240)
   // are noise and filled; parts it cuts off go by the blob rules above. One
   // pass: where the mask was two pixels too wide, it stays one too wide
