@@ -184,10 +184,32 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
   series_plot(score.pointing_errors, {"right", "left"}, "time_pointing_", " hand", "pointing error, degrees");
   gp << "unset multiplot\n";
 
+  // The silhouettes' IoU over time, a line per camera (when scored).
+  std::vector<std::string> names = {"joint_histograms", "errors_over_time"};
+  if (score.silhouettes && !score.silhouettes->frames.empty()) {
+    std::map<std::string, std::vector<std::tuple<int, double, bool>>> by_camera;
+    for (const SilhouetteCounts& c : score.silhouettes->frames) by_camera[c.camera].emplace_back(c.frame, c.iou(), false);
+    std::vector<std::string> cameras;
+    for (const auto& [camera, rows] : by_camera) cameras.push_back(camera);
+    gp << "set terminal svg size 960,380 font \"sans,11\" background rgb \"white\"\n"
+       << "set output \"silhouettes_over_time.svg\"\n"
+       << "set title \"Silhouettes against the truth masks: IoU per camera-frame\"\n"
+       << "set key outside right top\nset xlabel \"frame\"\nset ylabel \"IoU\"\n"
+       << "plot [*:*] [0:1] ";
+    for (size_t i = 0; i < cameras.size(); ++i) {
+      const std::string file = "silhouette_iou_" + cameras[i] + ".dat";
+      WriteSeries(workdir / file, by_camera[cameras[i]]);
+      gp << (i ? ", \\\n     " : "") << Quoted(file) << " using 1:2 with lines lw 1.5 lc rgb \"" << colours[i % 9]
+         << "\" title " << Quoted(cameras[i]) << " noenhanced";
+    }
+    gp << "\n";
+    names.push_back("silhouettes_over_time");
+  }
+
   AtomicWriteFile(workdir / "plots.gp", gp.str());
   RunGnuplot(gnuplot, workdir, "plots.gp");
   std::map<std::string, std::string> svgs;
-  for (const std::string name : {"joint_histograms", "errors_over_time"}) {
+  for (const std::string& name : names) {
     const fs::path file = workdir / (name + ".svg");
     if (!fs::is_regular_file(file)) throw RuntimeError("gnuplot wrote no " + file.string());
     svgs[name] = ReadText(file);

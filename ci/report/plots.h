@@ -25,7 +25,9 @@ void RunGnuplot(const std::filesystem::path& gnuplot, const std::filesystem::pat
 // returns plot name -> SVG text for "joint_histograms" (Fig. 6.8: one panel
 // per joint, Chauvenet outliers left out and counted in the panel's title)
 // and "errors_over_time" (joint errors in cm and pointing errors in degrees
-// against the frame; gaps where nothing was scored). The data and script
+// against the frame; gaps where nothing was scored) and, when the score has
+// silhouettes, "silhouettes_over_time" (their IoU per camera against the
+// frame). The data and script
 // stay in `workdir` so that a user can restyle them.
 std::map<std::string, std::string> DrawScorePlots(const Score& score, const std::filesystem::path& gnuplot,
                                                   const std::filesystem::path& workdir);

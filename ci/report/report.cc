@@ -495,7 +495,10 @@ ReportResult WriteReport(const Score& score, const ReportOptions& options, const
        << Tables(score) << "<h2>Plots</h2>\n";
   if (result.plots) {
     for (const auto& [name, title] : std::vector<std::pair<std::string, std::string>>{
-             {"joint_histograms", "Joint error histograms (Fig. 6.8)"}, {"errors_over_time", "Errors over time"}}) {
+             {"joint_histograms", "Joint error histograms (Fig. 6.8)"},
+             {"errors_over_time", "Errors over time"},
+             {"silhouettes_over_time", "Silhouettes: IoU over time, per camera"}}) {
+      if (!svgs.count(name)) continue;
       html << "<figure class=\"plot\" id=\"plot-" << name << "\"><img alt=\"" << Escape(title)
            << "\" src=\"data:image/svg+xml;base64," << Base64(svgs.at(name)) << "\"><figcaption>" << Escape(title)
            << " — also <code>plots/" << name << ".svg</code>, drawn by gnuplot from <code>plots/plots.gp</code>"

@@ -229,6 +229,15 @@ TEST_F(ScoreTest, SilhouettesBesideTheTrackAreScored) {
   const std::string page = irbench::testing::ReadText(out / "report.html");
   EXPECT_NE(page.find("<table id=\"silhouettes\">"), std::string::npos);
   EXPECT_NE(page.find("<tr><th>All</th><td>" + std::to_string(scored) + "</td>"), std::string::npos);
+  if (fs::exists(out / "plots" / "plots.gp")) {  // gnuplot was found
+    EXPECT_NE(page.find("id=\"plot-silhouettes_over_time\""), std::string::npos);
+    // The plotted series: a line "frame IoU" per scored camera-frame.
+    std::ifstream series(out / "plots" / ("silhouette_iou_" + moved_camera + ".dat"));
+    int lines = 0;
+    for (std::string line; std::getline(series, line);) lines += !line.empty();
+    EXPECT_EQ(lines, std::count_if(s.silhouettes->frames.begin(), s.silhouettes->frames.end(),
+                                   [&](const SilhouetteCounts& c) { return c.camera == moved_camera; }));
+  }
   // A track without silhouettes beside it: none scored, none invented.
   Write(dir_ / "plain.jsonl", track);
   job.track = dir_ / "plain.jsonl";
