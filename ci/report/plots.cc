@@ -199,7 +199,8 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
     for (size_t i = 0; i < cameras.size(); ++i) {
       const std::string file = "silhouette_iou_" + cameras[i] + ".dat";
       WriteSeries(workdir / file, by_camera[cameras[i]]);
-      gp << (i ? ", \\\n     " : "") << Quoted(file) << " using 1:2 with lines lw 1.5 lc rgb \"" << colours[i % 9]
+      gp << (i ? ", \\\n     " : "") << Quoted(file) << " using 1:2 with linespoints pt 7 ps 0.2 lw 1.5 lc rgb \""
+         << colours[i % 9]
          << "\" title " << Quoted(cameras[i]) << " noenhanced";
     }
     gp << "\n";

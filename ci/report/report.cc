@@ -135,7 +135,8 @@ std::string Tables(const Score& score) {
       const auto cell = [&](const std::string& v) { return "<td>" + (s.camera_frames ? v : std::string("–")) + "</td>"; };
       out << "<tr><th>" << Escape(name) << "</th><td>" << s.camera_frames << "</td>" << cell(Fixed(s.iou_median, 3))
           << cell(Fixed(s.iou_p10, 3)) << cell(Fixed(100 * s.false_share, 1) + " %")
-          << cell(Fixed(100 * s.missed_share, 1) + " %") << cell(Fixed(100 * s.near_outline_share, 0) + " %")
+          << cell(Fixed(100 * s.missed_share, 1) + " %")
+          << cell(s.near_outline_share ? Fixed(100 * *s.near_outline_share, 0) + " %" : std::string("–"))
           << "</tr>\n";
     };
     for (const auto& [camera, s] : sil.ByCamera()) row(camera, s);

@@ -6,6 +6,7 @@
 #include "ci/score/score.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/logging.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -34,7 +35,14 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score
   // truth masks.
   const fs::path silhouettes = track.parent_path() / "silhouettes";
   const fs::path masks = options.sequence / "truth" / "masks";
-  if (fs::is_directory(silhouettes) && fs::is_directory(masks)) score.silhouettes = ScoreSilhouettes(masks, silhouettes);
+  if (fs::is_directory(silhouettes)) {
+    if (fs::is_directory(masks)) {
+      score.silhouettes = ScoreSilhouettes(masks, silhouettes);
+    } else {
+      Log().warn("score: {} has no truth masks: the silhouettes in {} are not scored", options.sequence.string(),
+                 silhouettes.string());
+    }
+  }
   const fs::path out = options.out.empty() ? options.sequence / "score" : options.out;
   StagingDir staging(out, options.overwrite, "--out");
   nlohmann::json j = score.ToJson();

@@ -215,7 +215,7 @@ TEST_F(ScoreTest, SilhouettesBesideTheTrackAreScored) {
       EXPECT_LT(summary.iou_median, 1.0);
       EXPECT_DOUBLE_EQ(summary.false_share, double(moved_false) / moved_truth);
       EXPECT_DOUBLE_EQ(summary.missed_share, double(moved_missed) / moved_truth);
-      EXPECT_DOUBLE_EQ(summary.near_outline_share, 1.0);
+      EXPECT_EQ(summary.near_outline_share, 1.0);
     } else {
       EXPECT_DOUBLE_EQ(summary.iou_min, 1.0) << camera;
       EXPECT_DOUBLE_EQ(summary.false_share + summary.missed_share, 0.0) << camera;

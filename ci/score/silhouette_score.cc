@@ -1,12 +1,16 @@
 #include "ci/score/silhouette_score.h"
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <cstdio>
+#include <tuple>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "common/error.h"
+#include "common/logging.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -35,11 +39,11 @@ SilhouetteSummary Summarise(const std::vector<const SilhouetteCounts*>& frames) 
   }
   std::sort(ious.begin(), ious.end());
   s.iou_median = ious[ious.size() / 2];
-  s.iou_p10 = ious[ious.size() / 10];
+  s.iou_p10 = ious[(ious.size() - 1) / 10];  // nearest rank: the ceil(n / 10)-th smallest
   s.iou_min = ious.front();
   s.false_share = truth ? double(false_px) / truth : 0.0;
   s.missed_share = truth ? double(missed) / truth : 0.0;
-  s.near_outline_share = false_px + missed ? double(near) / double(false_px + missed) : 0.0;
+  if (false_px + missed) s.near_outline_share = double(near) / double(false_px + missed);
   return s;
 }
 
@@ -48,14 +52,14 @@ Json SummaryJson(const SilhouetteSummary& s) {
   return {{"camera_frames", s.camera_frames},         {"iou_median", value(s.iou_median)},
           {"iou_p10", value(s.iou_p10)},               {"iou_min", value(s.iou_min)},
           {"false_share", value(s.false_share)},       {"missed_share", value(s.missed_share)},
-          {"near_outline_share", value(s.near_outline_share)}};
+          {"near_outline_share", s.near_outline_share ? Json(*s.near_outline_share) : Json(nullptr)}};
 }
 
 std::string SummaryRow(const std::string& name, const SilhouetteSummary& s) {
   if (s.camera_frames == 0) return "| " + name + " | 0 | – | – | – | – | – |\n";
   return "| " + name + " | " + std::to_string(s.camera_frames) + " | " + Fixed(s.iou_median, 3) + " | " +
          Fixed(s.iou_p10, 3) + " | " + Fixed(100 * s.false_share, 1) + "% | " + Fixed(100 * s.missed_share, 1) +
-         "% | " + Fixed(100 * s.near_outline_share, 0) + "% |\n";
+         "% | " + (s.near_outline_share ? Fixed(100 * *s.near_outline_share, 0) + "%" : std::string("–")) + " |\n";
 }
 
 cv::Mat ReadMask(const fs::path& path) {
@@ -104,9 +108,20 @@ SilhouetteCounts CountSilhouette(const cv::Mat& truth, const cv::Mat& silhouette
 
 SilhouetteScore ScoreSilhouettes(const fs::path& masks, const fs::path& silhouettes) {
   SilhouetteScore score;
+  score.silhouettes = silhouettes;
+  int truth_masks = 0;
   for (const fs::path& camera_dir : SortedEntries(masks, true)) {
     const std::string camera = camera_dir.filename().string();
     for (const fs::path& truth_path : SortedEntries(camera_dir, false)) {
+      // The frame number: the whole name but ".png", digits only.
+      const std::string stem = truth_path.stem().string();
+      int frame = -1;
+      const auto [end, error] = std::from_chars(stem.data(), stem.data() + stem.size(), frame);
+      if (stem.empty() || error != std::errc() || end != stem.data() + stem.size() || frame < 0 ||
+          !std::isdigit(static_cast<unsigned char>(stem[0]))) {
+        throw InputError(truth_path.string(), "", "not a frame number (expected 000123.png)");
+      }
+      ++truth_masks;
       const fs::path silhouette_path = silhouettes / camera / truth_path.filename();
       if (!fs::exists(silhouette_path)) {
         ++score.missing;
@@ -126,13 +141,16 @@ SilhouetteScore ScoreSilhouettes(const fs::path& masks, const fs::path& silhouet
       }
       SilhouetteCounts c = CountSilhouette(truth, silhouette);
       c.camera = camera;
-      try {
-        c.frame = std::stoi(truth_path.stem().string());
-      } catch (const std::exception&) {
-        throw InputError(truth_path.string(), "", "not a frame number (expected 000123.png)");
-      }
+      c.frame = frame;
       score.frames.push_back(c);
     }
+  }
+  std::sort(score.frames.begin(), score.frames.end(), [](const SilhouetteCounts& a, const SilhouetteCounts& b) {
+    return std::tie(a.camera, a.frame) < std::tie(b.camera, b.frame);
+  });
+  if (truth_masks > 0 && score.missing == truth_masks) {
+    Log().warn("score: none of the {} truth masks in {} has a silhouette in {} (<camera>/<frame>.png)", truth_masks,
+               masks.string(), silhouettes.string());
   }
   return score;
 }
@@ -153,6 +171,7 @@ std::map<std::string, SilhouetteSummary> SilhouetteScore::ByCamera() const {
 
 nlohmann::json SilhouetteScore::ToJson() const {
   Json j = SummaryJson(All());
+  j["folder"] = fs::absolute(silhouettes).lexically_normal().string();
   j["missing"] = missing;
   j["empty_camera_frames"] = empty_frames;
   j["empty_false_pixels"] = empty_false;

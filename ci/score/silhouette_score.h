@@ -3,13 +3,14 @@
 // median IoU over camera-frames). Besides the IoU, each camera-frame's errors
 // are split by where they lie: within one pixel of the true outline (an
 // 8-neighbour of a pixel on the other side of it) or farther. At 320x240 a
-// one-pixel ring round a body is about a tenth of its area, so the split tells
-// an outline that is a pixel off (lens blur, dark rims) from what is wrong
-// (shadows, lost limbs).
+// one-pixel ring round a body is a sixth to a quarter of its area (more seen
+// from overhead), so the split tells an outline that is a pixel off (blur,
+// dark rims) from what is wrong (shadows, lost limbs).
 
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -34,17 +35,19 @@ struct SilhouetteCounts {
 struct SilhouetteSummary {
   int camera_frames = 0;
   double iou_median = 0;  // the middle one (the upper of the two for an even count)
-  double iou_p10 = 0;     // the tenth percentile: the bad frames
+  double iou_p10 = 0;     // the tenth percentile (nearest rank): the bad frames
   double iou_min = 0;
   // Sums over the camera-frames, as a share of the true body's pixels.
   double false_share = 0;
   double missed_share = 0;
-  // Of all false and missed pixels, the share within one pixel of the true outline.
-  double near_outline_share = 0;
+  // Of all false and missed pixels, the share within one pixel of the true
+  // outline; nullopt when there are none.
+  std::optional<double> near_outline_share;
 };
 
 struct SilhouetteScore {
-  std::vector<SilhouetteCounts> frames;  // by camera name, then frame
+  std::filesystem::path silhouettes;     // the folder scored
+  std::vector<SilhouetteCounts> frames;  // by camera name, then frame number
   // Camera-frames whose truth mask is empty (the person out of view): not in
   // the IoU; the silhouette pixels found there are false foreground.
   int empty_frames = 0;
@@ -64,9 +67,11 @@ struct SilhouetteScore {
 SilhouetteCounts CountSilhouette(const cv::Mat& truth, const cv::Mat& silhouette);
 
 // Scores `silhouettes`/<camera>/<frame>.png (irbench track's) against
-// `masks`/<camera>/<frame>.png (the sequence's truth/masks). Throws
-// InputError naming the file for an unreadable image or one of another size
-// than its truth mask.
+// `masks`/<camera>/<frame>.png (the sequence's truth/masks; frame names are
+// digits only, 000123.png). Throws InputError naming the file for a truth
+// mask whose name is no frame number, an unreadable image, or one of another
+// size than its truth mask. Logs a warning when no truth mask has a
+// silhouette (another tracker's names?).
 SilhouetteScore ScoreSilhouettes(const std::filesystem::path& masks, const std::filesystem::path& silhouettes);
 
 }  // namespace irbench

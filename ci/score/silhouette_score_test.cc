@@ -8,6 +8,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -115,12 +118,13 @@ TEST_F(SilhouetteFolderTest, SummariesOverCamerasAndFrames) {
   EXPECT_DOUBLE_EQ(all.iou_min, 200.0 / 264.0);
   EXPECT_DOUBLE_EQ(all.false_share, (10.0 + 64.0) / 800.0);
   EXPECT_DOUBLE_EQ(all.missed_share, 10.0 / 800.0);
-  EXPECT_DOUBLE_EQ(all.near_outline_share, 1.0);
+  ASSERT_TRUE(all.near_outline_share);
+  EXPECT_DOUBLE_EQ(*all.near_outline_share, 1.0);
   const auto by_camera = s.ByCamera();
   EXPECT_EQ(by_camera.at("a").camera_frames, 3);
   EXPECT_DOUBLE_EQ(by_camera.at("a").iou_median, 190.0 / 210.0);
   EXPECT_DOUBLE_EQ(by_camera.at("b").iou_median, 1.0);
-  EXPECT_DOUBLE_EQ(by_camera.at("b").near_outline_share, 0.0);  // no errors at all
+  EXPECT_FALSE(by_camera.at("b").near_outline_share);  // no errors at all: no share
   const nlohmann::json j = s.ToJson();
   EXPECT_DOUBLE_EQ(j["iou_median"].get<double>(), 1.0);
   EXPECT_EQ(j["cameras"]["a"]["camera_frames"], 3);
@@ -129,10 +133,38 @@ TEST_F(SilhouetteFolderTest, SummariesOverCamerasAndFrames) {
   const std::string md = s.Markdown();
   EXPECT_NE(md.find("| a | 3 | 0.905 | 0.758 | 12.3% | 1.7% | 100% |"), std::string::npos) << md;
   EXPECT_NE(md.find("| All | 4 | 1.000 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| b | 1 | 1.000 | 1.000 | 0.0% | 0.0% | – |"), std::string::npos) << md;
+  EXPECT_TRUE(j["cameras"]["b"]["near_outline_share"].is_null());
   EXPECT_NE(md.find("1 camera-frames without the person in view: 5 silhouette pixels"), std::string::npos) << md;
   const std::string csv = s.Csv();
   EXPECT_NE(csv.find("a,1,200,200,0.904762,10,0,10,0\n"), std::string::npos) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);  // header and four camera-frames
+}
+
+// Twenty camera-frames of known IoU (k/20 of a 20-pixel bar found, k = 1..20,
+// written in shuffled order and with unpadded names): the tenth percentile is
+// the second smallest (nearest rank), the median the eleventh, and the frames
+// come out by number.
+TEST_F(SilhouetteFolderTest, PercentilesByRankAndFramesByNumber) {
+  const cv::Size size(40, 10);
+  const cv::Mat bar = Rect(size, {0, 0, 20, 1});
+  for (const int k : {7, 20, 1, 13, 2, 9, 16, 4, 11, 18, 3, 14, 6, 19, 10, 5, 17, 8, 15, 12}) {
+    const std::string name = std::to_string(k);  // 1.png ... 20.png
+    fs::create_directories(dir_ / "masks/c");
+    fs::create_directories(dir_ / "sil/c");
+    ASSERT_TRUE(cv::imwrite((dir_ / "masks/c" / (name + ".png")).string(), bar));
+    ASSERT_TRUE(cv::imwrite((dir_ / "sil/c" / (name + ".png")).string(), Rect(size, {0, 0, k, 1})));
+  }
+  const SilhouetteScore s = ScoreSilhouettes(dir_ / "masks", dir_ / "sil");
+  ASSERT_EQ(s.frames.size(), 20u);
+  for (size_t i = 0; i < s.frames.size(); ++i) {
+    EXPECT_EQ(s.frames[i].frame, int(i) + 1);
+    EXPECT_DOUBLE_EQ(s.frames[i].iou(), (i + 1) / 20.0);
+  }
+  const SilhouetteSummary all = s.All();
+  EXPECT_DOUBLE_EQ(all.iou_p10, 2 / 20.0);
+  EXPECT_DOUBLE_EQ(all.iou_median, 11 / 20.0);
+  EXPECT_DOUBLE_EQ(all.iou_min, 1 / 20.0);
 }
 
 TEST_F(SilhouetteFolderTest, BadImagesNameTheFile) {
@@ -153,6 +185,17 @@ TEST_F(SilhouetteFolderTest, BadImagesNameTheFile) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.file(), (dir_ / "sil/a/000000.png").string());
     EXPECT_EQ(e.message(), "unreadable image");
+  }
+  // A truth mask whose name is no frame number, with or without a silhouette.
+  Put("masks", "a", 0, Rect(size, {10, 10, 20, 10}));
+  Put("sil", "a", 0, Rect(size, {10, 10, 20, 10}));
+  ASSERT_TRUE(cv::imwrite((dir_ / "masks/a/000001_old.png").string(), Rect(size, {10, 10, 20, 10})));
+  try {
+    ScoreSilhouettes(dir_ / "masks", dir_ / "sil");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), (dir_ / "masks/a/000001_old.png").string());
+    EXPECT_NE(e.message().find("not a frame number"), std::string::npos) << e.what();
   }
 }
 
