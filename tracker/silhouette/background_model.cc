@@ -170,7 +170,11 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   for (int y = 0; y < size.height; y += 2) {
     const uint8_t* lp = light_pixels.ptr<uint8_t>(y);
     for (int x = 0; x < size.width; x += 2) {
-      if (lp[x]) m.light_samples_.push_back({y, x});
+      if (lp[x]) {
+        m.light_samples_.push_back({y, x});
+        m.light_a_.push_back(m.a_.ptr<float>(y)[x]);
+        m.light_b_.push_back(m.b_.ptr<float>(y)[x]);
+      }
     }
   }
   // The noises the thresholds are set in, measured on the training frames:
@@ -201,8 +205,8 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     // Floors: what 8-bit rounding alone gives after the same filters (white
     // noise of 1/√12 grey levels a pixel; in z, over the floor of σ). Frames
     // without noise (the `clean` preset) would otherwise set the thresholds
-    // at a thousandth of a grey level, and the faintest tail of the blurred
-    // outline would join the body.
+    // at nothing (the old floor of 1e-3: a thousandth of z or of a grey
+    // level), and the faintest tail of the blurred outline would join the body.
     const auto filtered_norm = [&](double sigma, bool laplacian) {
       const int half = static_cast<int>(std::ceil(5 * sigma)) + 2;
       cv::Mat delta = cv::Mat::zeros(2 * half + 1, 2 * half + 1, CV_32F), out;
@@ -274,9 +278,11 @@ double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
   if (light_pixel_count_ < kMinLightPixels) return mean_light_;
   thread_local std::vector<float> estimates;
   estimates.resize(light_samples_.size());
+  // a and b come in arrays of their own: one read scattered over the frame
+  // instead of three.
   for (size_t i = 0; i < light_samples_.size(); ++i) {
     const auto [y, x] = light_samples_[i];
-    estimates[i] = (frame.ptr<uint8_t>(y)[x] - a_.ptr<float>(y)[x]) / b_.ptr<float>(y)[x];
+    estimates[i] = (frame.ptr<uint8_t>(y)[x] - light_a_[i]) / light_b_[i];
   }
   if (estimates.empty()) return mean_light_;
   return ValueOfRank(estimates, estimates.size() / 2);
@@ -445,7 +451,11 @@ void BackgroundModel::RefineOutline(const cv::Mat& z, cv::Mat& mask) const {
   refined.copyTo(local);
 }
 
-int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, int near_px, int near_min_area) {
+namespace {
+
+// CleanMask on `mask`, a view that holds every nonzero pixel of its image
+// with room about them for the morphology.
+int CleanRegion(cv::Mat& mask, int open_radius, int close_radius, int min_area, int near_px, int near_min_area) {
   auto kernel = [](int r) {
     return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
   };
@@ -513,6 +523,21 @@ int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, in
     for (int x = 0; x < mask.cols; ++x) mp[x] = keep[lp[x]] ? 255 : 0;
   }
   return removed;
+}
+
+}  // namespace
+
+int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, int near_px, int near_min_area) {
+  // Only the box about the nonzero pixels, grown by what the opening and the
+  // closing can reach (their dilations, and the erosions that read around
+  // them), changes or is read: the same result for a fraction of the image.
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return 0;
+  const int margin = 2 * (std::max(open_radius, 0) + std::max(close_radius, 0)) + 1;
+  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+                       cv::Rect(0, 0, mask.cols, mask.rows);
+  cv::Mat local = mask(roi);
+  return CleanRegion(local, open_radius, close_radius, min_area, near_px, near_min_area);
 }
 
 }  // namespace irbench

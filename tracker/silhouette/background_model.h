@@ -134,6 +134,7 @@ class BackgroundModel {
 
   int light_pixel_count_ = 0;  // pixels whose b is large enough to read L from
   std::vector<std::pair<int, int>> light_samples_;  // (y, x): those on even rows and columns
+  std::vector<float> light_a_, light_b_;             // a_ and b_ there, in the same order
   cv::Mat screen_;        // CV_8U: screen pixels (may be empty)
   cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;

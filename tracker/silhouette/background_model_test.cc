@@ -361,7 +361,7 @@ TEST(BackgroundModelTest, RefinedOutlineDoesNotGrowWithTheContrast) {
 // take the faintest tail of the blurred outline. The noises are floored at
 // what 8-bit rounding alone gives. A straight edge blurred by sigma 1.3 at
 // contrast 24: without the floors the outline lies 3.4-3.7 px out, with them
-// 1.1 px on one side and 2.0 on the other (the refinement decides a band of
+// 1.1 px on the right and 2.0 on the left (the refinement decides a band of
 // one pixel about the outline the pooling found; a second pass would take the
 // second pixel here, but costs the `thesis` preset's silhouettes 0.002 IoU).
 TEST(BackgroundModelTest, NoiseFreeFramesKeepTheOutlineOnTheEdge) {
