@@ -20,8 +20,13 @@ void ShadowOptions::Check() const {
 }
 
 cv::Mat ShadowRemover::Edges(const cv::Mat& frame) const {
-  cv::Mat smooth = frame, edges;
-  if (options_.blur_sigma > 0) cv::GaussianBlur(frame, smooth, cv::Size(), options_.blur_sigma);
+  // A blur into a header of `frame` itself would write over the caller's image.
+  cv::Mat smooth, edges;
+  if (options_.blur_sigma > 0) {
+    cv::GaussianBlur(frame, smooth, cv::Size(), options_.blur_sigma);
+  } else {
+    smooth = frame;
+  }
   cv::Canny(smooth, edges, options_.canny_low, options_.canny_high, 3, true);
   return edges;
 }
