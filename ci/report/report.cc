@@ -208,10 +208,18 @@ Json ViewerData(const Score& score, const ReportOptions& options, const Sequence
   data["cameras"] = Json::array();
   for (size_t c = 0; c < cameras.size(); ++c) {
     const fs::path folder = input.FramePath(int(c), 0).parent_path();
-    data["cameras"].push_back({{"name", cameras[c].name},
-                               {"width", cameras[c].width},
-                               {"height", cameras[c].height},
-                               {"dir", fs::relative(fs::absolute(folder), fs::absolute(options.final_dir)).generic_string() + "/"}});
+    const auto relative = [&](const fs::path& dir) {
+      return fs::relative(fs::absolute(dir), fs::absolute(options.final_dir)).generic_string() + "/";
+    };
+    Json cam = {{"name", cameras[c].name}, {"width", cameras[c].width}, {"height", cameras[c].height},
+                {"dir", relative(folder)}};
+    // The silhouettes the score compared, and the truth masks, for the
+    // viewer's overlay.
+    if (score.silhouettes && !score.silhouettes->frames.empty()) {
+      cam["silhouettes"] = relative(score.silhouettes->silhouettes / cameras[c].name);
+      cam["masks"] = relative(options.sequence / "truth" / "masks" / cameras[c].name);
+    }
+    data["cameras"].push_back(cam);
   }
   // Joint names from the truth (all of them, legs too), in a fixed order.
   std::vector<std::string> names;
@@ -365,8 +373,20 @@ constexpr const char* kScript = R"js(
     cams.appendChild(fig);
     const img = new Image();
     img.addEventListener('error', () => console.error('report: cannot load ' + img.src));
-    return { cam, img, canvas };
+    // The silhouette and the truth mask, each tinted on a canvas of its own
+    // (compositing only: a page opened from file:// may not read pixels back).
+    const layer = (colour) => {
+      const m = new Image();
+      m.addEventListener('error', () => console.error('report: cannot load ' + m.src));
+      const tint = document.createElement('canvas');
+      tint.width = cam.width;
+      tint.height = cam.height;
+      return { img: m, tint, colour };
+    };
+    const masks = cam.silhouettes ? [layer('#ff2020'), layer('#20c020')] : [];
+    return { cam, img, canvas, masks };
   });
+  const overlay = document.getElementById('show-silhouettes');
   const pad = (n) => String(n).padStart(6, '0');
   // The image window to show: the whole image, or (zoomed) a box about
   // everything drawn in this camera, with the image's aspect ratio.
@@ -398,6 +418,24 @@ constexpr const char* kScript = R"js(
     ctx.fillRect(0, 0, view.canvas.width, view.canvas.height);
     if (view.img.complete && view.img.naturalWidth) {
       ctx.drawImage(view.img, win.x, win.y, win.w, win.h, 0, 0, view.canvas.width, view.canvas.height);
+    }
+    // Silhouette red, truth green, added: yellow where they agree, red false
+    // foreground, green missed body.
+    if (overlay && overlay.checked) {
+      for (const m of view.masks) {
+        if (!(m.img.complete && m.img.naturalWidth)) continue;
+        const t = m.tint.getContext('2d');
+        t.globalCompositeOperation = 'source-over';
+        t.drawImage(m.img, 0, 0);
+        t.globalCompositeOperation = 'multiply';
+        t.fillStyle = m.colour;
+        t.fillRect(0, 0, m.tint.width, m.tint.height);
+        ctx.globalCompositeOperation = 'lighter';
+        ctx.globalAlpha = 0.6;
+        ctx.drawImage(m.tint, win.x, win.y, win.w, win.h, 0, 0, view.canvas.width, view.canvas.height);
+        ctx.globalAlpha = 1;
+        ctx.globalCompositeOperation = 'source-over';
+      }
     }
     function skeleton(pts, stride, colour, dashedWhenHidden) {
       ctx.strokeStyle = colour;
@@ -444,12 +482,20 @@ constexpr const char* kScript = R"js(
     views.forEach((view, c) => {
       view.img.onload = () => draw(view, fr, c);
       view.img.src = view.cam.dir + pad(fr.f) + '.png';
+      if (overlay && overlay.checked) {
+        [view.cam.silhouettes, view.cam.masks].forEach((dir, i) => {
+          const m = view.masks[i];
+          m.img.onload = () => draw(view, fr, c);
+          m.img.src = dir + pad(fr.f) + '.png';
+        });
+      }
       draw(view, fr, c);
     });
   }
   slider.max = data.frames.length - 1;
   slider.addEventListener('input', () => show(Number(slider.value)));
   zoom.addEventListener('change', () => show(Number(slider.value)));
+  if (overlay) overlay.addEventListener('change', () => show(Number(slider.value)));
   document.getElementById('prev').addEventListener('click', () => show(Number(slider.value) - 1));
   document.getElementById('next').addEventListener('click', () => show(Number(slider.value) + 1));
   for (const f of data.worst) {
@@ -515,7 +561,13 @@ ReportResult WriteReport(const Score& score, const ReportOptions& options, const
        << "<input type=\"range\" id=\"frame\" min=\"0\" max=\"0\" value=\"0\">"
        << "<button id=\"next\" title=\"next frame (→)\">▶</button><span id=\"frame-info\"></span>"
        << "<label>worst frames first: <select id=\"worst\"></select></label>"
-       << "<label><input type=\"checkbox\" id=\"zoom\" checked> zoom to the person</label></div>\n"
+       << "<label><input type=\"checkbox\" id=\"zoom\" checked> zoom to the person</label>"
+       << (score.silhouettes && !score.silhouettes->frames.empty()
+               ? "<label title=\"the tracker's silhouette red, the truth mask green: yellow where they agree, red "
+                 "false foreground, green missed body\"><input type=\"checkbox\" id=\"show-silhouettes\"> silhouettes "
+                 "against the truth masks</label>"
+               : "")
+       << "</div>\n"
        << "<div class=\"cams\" id=\"cams\"></div>\n"
        << "<script type=\"application/json\" id=\"viewer-data\">" << json << "</script>\n"
        << "<script>" << kScript << "</script>\n</body>\n</html>\n";

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -234,6 +235,70 @@ TEST_F(ReportTest, OpensInHeadlessChromiumWithoutConsoleErrors) {
   const BrowserRun broken = OpenInChromium(*chromium, moved / "elsewhere/report.html", dir_ / "browser_broken");
   ASSERT_FALSE(broken.console.empty());
   EXPECT_NE(broken.console.front().find("report: cannot load"), std::string::npos) << broken.console.front();
+}
+
+// The viewer's silhouette overlay: a track whose silhouettes are the truth
+// masks moved 4 px to the right. With the overlay on, the page loads the
+// masks without a console message and draws the agreement yellow, the false
+// foreground red and the missed body green.
+TEST_F(ReportTest, SilhouetteOverlayDrawsAgreementAndErrors) {
+  const std::optional<fs::path> chromium = FindChromium();
+  if (!chromium) GTEST_SKIP() << "no Chromium (ci/install_deps.sh installs Debian's chromium)";
+  const fs::path folder = dir_ / "with_silhouettes";
+  fs::create_directories(folder);
+  fs::copy_file(dir_ / "track.jsonl", folder / "track.jsonl", fs::copy_options::overwrite_existing);
+  for (const auto& camera : fs::directory_iterator(dir_ / "seq/truth/masks")) {
+    fs::create_directories(folder / "silhouettes" / camera.path().filename());
+    for (const auto& file : fs::directory_iterator(camera.path())) {
+      const cv::Mat mask = cv::imread(file.path().string(), cv::IMREAD_GRAYSCALE);
+      ASSERT_FALSE(mask.empty());
+      cv::Mat moved = cv::Mat::zeros(mask.size(), CV_8U);
+      mask.colRange(0, mask.cols - 4).copyTo(moved.colRange(4, mask.cols));
+      cv::imwrite((folder / "silhouettes" / camera.path().filename() / file.path().filename()).string(), moved);
+    }
+  }
+  ScoreJobOptions job;
+  job.sequence = dir_ / "seq";
+  job.track = folder / "track.jsonl";
+  job.out = dir_ / "score_overlay";
+  job.overwrite = true;
+  RunScoreJob(job);
+  std::string page = ReadText(job.out / "report.html");
+  const Json data = ViewerData(page);
+  ASSERT_TRUE(data["cameras"][0].contains("silhouettes"));
+  EXPECT_EQ(data["cameras"][0]["silhouettes"].get<std::string>(),
+            "../with_silhouettes/silhouettes/" + data["cameras"][0]["name"].get<std::string>() + "/");
+  // Turn the overlay on, as a click would.
+  const std::string box = "id=\"show-silhouettes\">";
+  const size_t at = page.find(box);
+  ASSERT_NE(at, std::string::npos);
+  page.replace(at, box.size(), "id=\"show-silhouettes\" checked>");
+  irbench::testing::WriteText(job.out / "overlay.html", page);
+  // Pixels of the three colours, with the overlay and without it (the
+  // skeletons and the model have greens and oranges of their own).
+  const auto colours = [&](const fs::path& html, const fs::path& work) {
+    const BrowserRun run = OpenInChromium(*chromium, html, work);
+    EXPECT_EQ(run.status, 0) << ReadText(work / "chromium.log");
+    EXPECT_TRUE(run.console.empty()) << run.console.front();
+    const cv::Mat shot = cv::imread(run.screenshot.string(), cv::IMREAD_COLOR);
+    std::array<int, 3> count = {0, 0, 0};  // yellow, red, green
+    for (int y = 0; y < shot.rows; ++y) {
+      for (int x = 0; x < shot.cols; ++x) {
+        const cv::Vec3b p = shot.at<cv::Vec3b>(y, x);  // B, G, R
+        count[0] += p[2] > 150 && p[1] > 150 && p[0] < 110;
+        count[1] += p[2] > 150 && p[1] < 110 && p[0] < 110;
+        count[2] += p[1] > 140 && p[2] < 110 && p[0] < 110;
+      }
+    }
+    return count;
+  };
+  const std::array<int, 3> on = colours(job.out / "overlay.html", dir_ / "browser_overlay");
+  const std::array<int, 3> off = colours(job.out / "report.html", dir_ / "browser_no_overlay");
+  std::printf("yellow, red, green pixels: with the overlay %d, %d, %d; without %d, %d, %d\n", on[0], on[1], on[2],
+              off[0], off[1], off[2]);
+  EXPECT_GT(on[0] - off[0], 500);
+  EXPECT_GT(on[1] - off[1], 100);
+  EXPECT_GT(on[2] - off[2], 100);
 }
 
 }  // namespace
