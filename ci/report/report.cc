@@ -64,12 +64,6 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
-std::string Fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
-}
-
 double Round1(double v) { return std::round(v * 10) / 10; }
 
 std::string StatsRow(const std::string& name, const ErrorStats& s) {

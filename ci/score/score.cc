@@ -86,19 +86,18 @@ const Json* Child(const Json& j, const std::string& key) {
   return j.is_object() && j.contains(key) && !j[key].is_null() ? &j[key] : nullptr;
 }
 
-std::string Fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
-}
-
-
 }  // namespace
 
 std::map<int, Json> ReadFrameLines(const fs::path& path) {
   std::map<int, Json> by_frame;
   ReadJsonLines(path, &by_frame);
   return by_frame;
+}
+
+std::string Fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
 }
 
 std::string TitleCase(const std::string& joint) {

@@ -53,6 +53,9 @@ std::map<int, nlohmann::json> ReadFrameLines(const std::filesystem::path& path);
 // "right_elbow" -> "Right Elbow": names as the tables print them.
 std::string TitleCase(const std::string& name);
 
+// `v` with `digits` decimals ("%.*f"), for the tables.
+std::string Fixed(double v, int digits);
+
 // The nine joints of Table 6.1, in its order.
 const std::vector<std::string>& ScoredJoints();
 

@@ -1,5 +1,7 @@
 #include "tracker/silhouette/background_model.h"
 
+#include "tracker/silhouette/internal/box.h"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -390,8 +392,7 @@ void BackgroundModel::RefineOutline(const cv::Mat& z, cv::Mat& mask) const {
   // Room for the band, the wider Gaussian (OpenCV's float kernels reach 4
   // sigma) and the Laplacian, so that every value read is the whole image's.
   const int margin = band + static_cast<int>(std::ceil(4 * side_sigma)) + 2;
-  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
-                       cv::Rect(0, 0, z.cols, z.rows);
+  const cv::Rect roi = silhouette_internal::GrownWithin(box, margin, z.size());
   // The blur acts on intensities: back from z to grey levels, I − μ(t).
   const cv::Mat difference = z(roi).mul(sigma_(roi));
   cv::Mat smooth, laplacian, side;
@@ -534,8 +535,7 @@ int CleanMask(cv::Mat& mask, int open_radius, int close_radius, int min_area, in
   const cv::Rect box = cv::boundingRect(mask);
   if (box.empty()) return 0;
   const int margin = 2 * (std::max(open_radius, 0) + std::max(close_radius, 0)) + 1;
-  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
-                       cv::Rect(0, 0, mask.cols, mask.rows);
+  const cv::Rect roi = silhouette_internal::GrownWithin(box, margin, mask.size());
   cv::Mat local = mask(roi);
   return CleanRegion(local, open_radius, close_radius, min_area, near_px, near_min_area);
 }

@@ -1,5 +1,7 @@
 #include "tracker/silhouette/shadow_removal.h"
 
+#include "tracker/silhouette/internal/box.h"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -81,8 +83,7 @@ cv::Mat ShadowRemover::Remove(const cv::Mat& frame, const cv::Mat& silhouette, c
   const double scale = frame.cols / 320.0;
   const int margin = static_cast<int>(std::ceil((4 * options_.blur_sigma + options_.edge_dilate +
                                                  options_.edge_reach + 4) * scale));
-  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
-                       cv::Rect(0, 0, frame.cols, frame.rows);
+  const cv::Rect roi = silhouette_internal::GrownWithin(box, margin, frame.size());
   const cv::Mat edges = SegmentedEdges(frame(roi), silhouette(roi), background_edges_(roi), scale);
   KeepEnclosed(silhouette(roi), edges, options_.min_directions,
                static_cast<int>(std::lround(options_.edge_reach * scale)))
