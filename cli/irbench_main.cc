@@ -84,6 +84,11 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--background-frames", render.background_frames,
                          "empty-stage frames per camera")
       ->capture_default_str();
+  bool no_sweep = false;
+  render_cmd->add_flag("--no-screen-sweep", no_sweep,
+                       "film the empty stage with the screens playing their content; by default they show a "
+                       "brightness ramp (0.25 to 1.75 of the content's level) so the tracker can tell their light "
+                       "from the illuminators'");
   render_cmd->add_option("--seed", render.seed, "seed for everything random")->capture_default_str();
   std::string out;
   render_cmd->add_option("--out", out,
@@ -266,6 +271,7 @@ int main(int argc, char** argv) {
     if (render_cmd->parsed()) {
       if (render_cmd->count("--frames") > 0) render.frames = frames;
       render.out = out;
+      render.screen_sweep = !no_sweep;
       render.backend = BackendOrThrow(render_backend);
       ApplyShadows(render_shadows, render);
       const std::filesystem::path folder = irbench::RunRenderJob(render);

@@ -69,7 +69,7 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
   for (size_t i = 0; i < list.Size(); ++i) {
     const JsonNode s = list[i];
     s.CheckKeys({"name", "scene", "rig", "avatar", "motion", "sensor", "seed", "frames", "background_frames",
-                 "track", "thresholds"});
+                 "background_screen_sweep", "track", "thresholds"});
     Scenario sc;
     sc.name = s.GetString("name");
     for (const Scenario& other : out) {
@@ -87,6 +87,7 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
     }
     sc.render.background_frames = s.GetInt("background_frames", 12);
     if (sc.render.background_frames < 2) s["background_frames"].Fail("the tracker needs at least 2");
+    sc.render.screen_sweep = s.GetBool("background_screen_sweep", true);
     if (s.Has("track")) {
       const JsonNode t = s["track"];
       t.CheckKeys({"background_model", "remove_shadows", "hull_missing_views", "particles"});
@@ -131,7 +132,8 @@ std::string CacheKey(const RenderJobOptions& r) {
   const RenderInputs in = LoadRenderInputs(r);  // validates, resolves names to files
   std::string key = ToolVersion() + "|" + r.rig + "|" + r.scene + "|" + r.avatar + "|" + r.motion + "|" + r.sensor +
                     "|" + std::to_string(r.seed) + "|" + std::to_string(r.frames.value_or(-1)) + "|" +
-                    std::to_string(r.background_frames) + "|" + std::to_string(r.supersample);
+                    std::to_string(r.background_frames) + "|" + std::to_string(r.supersample) +
+                    (r.screen_sweep ? "|sweep" : "");
   for (const fs::path& f : {in.rig_file, in.scene_file, in.avatar_file, in.motion_file}) {
     if (f.empty() || !fs::is_regular_file(f)) continue;
     std::ifstream file(f, std::ios::binary);

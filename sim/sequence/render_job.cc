@@ -41,6 +41,11 @@ nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
+double ScreenSweepLevel(int index, int count) {
+  if (count < 2) return 1.0;
+  return kSweepLow + (kSweepHigh - kSweepLow) * index / (count - 1);
+}
+
 RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   RenderInputs in;
   const auto preset = SensorPreset(options.sensor);
@@ -209,6 +214,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["fps"] = in.fps;
   manifest["frame_count"] = in.frame_count;
   manifest["background_frame_count"] = options.background_frames;
+  manifest["background_screen_sweep"] =
+      options.screen_sweep ? nlohmann::json{{"from", kSweepLow}, {"to", kSweepHigh}} : nlohmann::json(nullptr);
   nlohmann::json camera_names = nlohmann::json::array();
   for (const Camera& cam : in.rig.cameras) camera_names.push_back(cam.name);
   manifest["cameras"] = camera_names;
@@ -266,13 +273,14 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   // exposure's sub-frames, `radiance_sum` / `samples`) into the written frame:
   // the illuminators' light follows the mains, the screens' content light the
   // content's flicker, each row its own with a rolling shutter; the 940 nm
-  // light counts by the sensor's relative quantum efficiency. Records the
-  // levels, exposure and drops in `sensor_truth`.
+  // light counts by the sensor's relative quantum efficiency. A `sweep` level
+  // of 0 or more replaces the content's (the calibration sweep of empty-stage
+  // frames). Records the levels, exposure and drops in `sensor_truth`.
   std::vector<cv::Mat> last_written(in.rig.cameras.size());
   std::vector<double> last_flicker(in.rig.cameras.size(), 1.0);  // of the image a drop repeats
   cv::Mat radiance;
   auto expose = [&](size_t c, const CameraImages& images, const cv::Mat& radiance_sum, int samples,
-                    double t, uint64_t noise_frame, nlohmann::json& sensor_truth) -> cv::Mat {
+                    double t, uint64_t noise_frame, nlohmann::json& sensor_truth, double sweep = -1) -> cv::Mat {
     const Camera& cam = in.rig.cameras[c];
     if (!in.sensor_active[c]) {
       sensor_truth[cam.name] = {{"flicker", 1.0}, {"screen", 1.0}, {"illuminators", 1.0},
@@ -285,7 +293,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     const double exposure_s = cam.exposure_ms / 1000.0;
     const double start_s = t - 0.5 * exposure_s;
     const double mains = flickers[c].MainsMean(start_s, exposure_s);
-    const double screen = flickers[c].ScreenMean(start_s, exposure_s);
+    const double screen = sweep >= 0 ? sweep : flickers[c].ScreenMean(start_s, exposure_s);
     const double drop_u = UniformFromHash(MixHash(options.seed, 0xD50Bull + c), noise_frame);
     const bool dropped = drop_u < setup.capture.drop_rate && !last_written[c].empty();
     nlohmann::json& truth = sensor_truth[cam.name];
@@ -311,7 +319,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
       for (int y = 0; y < sources.rows; ++y) {
         const double row_start = start_s + (double(y) / (sources.rows - 1) - 0.5) * readout_s;
         const float m = static_cast<float>(flickers[c].MainsMean(row_start, exposure_s));
-        const float s = static_cast<float>(flickers[c].ScreenMean(row_start, exposure_s));
+        const float s = static_cast<float>(sweep >= 0 ? sweep : flickers[c].ScreenMean(row_start, exposure_s));
         const cv::Vec4f* in_row = sources.ptr<cv::Vec4f>(y);
         float* out_row = radiance.ptr<float>(y);
         double row_sum = 0;
@@ -340,7 +348,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const cv::Mat frame = expose(c, all_images[c], cv::Mat(), 1, t, (1ull << 40) + f, sensor_truth);
+      const double sweep = options.screen_sweep ? ScreenSweepLevel(f, options.background_frames) : -1.0;
+      const cv::Mat frame = expose(c, all_images[c], cv::Mat(), 1, t, (1ull << 40) + f, sensor_truth, sweep);
       WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }
     background_lines += nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";

@@ -26,6 +26,12 @@ struct RenderJobOptions {
   std::string motion = "wave";
   std::optional<int> frames;  // default: the motion's duration
   int background_frames = 10;
+  // The empty-stage frames are filmed while the screens show a brightness
+  // ramp, from kSweepLow to kSweepHigh times the content's nominal level (a
+  // calibration sweep an installer runs with the empty theater), so that the
+  // tracker can tell the screens' light on the stage from the illuminators'.
+  // false: the screens play their content, flickering as during the sequence.
+  bool screen_sweep = true;
   uint64_t seed = 1;
   std::string sensor = "clean";
   std::filesystem::path out;  // empty: renders/<rig>-<avatar>-<motion>-s<seed>
@@ -37,6 +43,12 @@ struct RenderJobOptions {
   // than clean.
   std::optional<bool> shadows;
 };
+
+// The screens' level in empty-stage frame `index` of `count` with the
+// calibration sweep on: evenly from kSweepLow to kSweepHigh (their mean is the
+// content's nominal level, 1).
+constexpr double kSweepLow = 0.25, kSweepHigh = 1.75;
+double ScreenSweepLevel(int index, int count);
 
 // Everything a render needs, loaded and validated (InputError on bad input).
 struct RenderInputs {

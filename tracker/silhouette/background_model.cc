@@ -11,6 +11,18 @@ namespace irbench {
 namespace {
 // Fewer pixels than this that follow the light clearly: L cannot be read.
 constexpr int kMinLightPixels = 50;
+
+// The root sum of squares of a Gaussian kernel of `sigma` px (or of its
+// Laplacian), as OpenCV applies them: white noise filtered by it keeps this
+// share of its standard deviation.
+double GaussianNorm(double sigma, bool laplacian) {
+  const int half = static_cast<int>(std::ceil(5 * sigma)) + 2;
+  cv::Mat delta = cv::Mat::zeros(2 * half + 1, 2 * half + 1, CV_32F), out;
+  delta.at<float>(half, half) = 1;
+  cv::GaussianBlur(delta, out, cv::Size(), sigma);
+  if (laplacian) cv::Laplacian(out, out, CV_32F);
+  return std::sqrt(out.dot(out));
+}
 }  // namespace
 
 // By way of a sample: the sample's quantiles about k bracket the value, one
@@ -66,6 +78,9 @@ void BackgroundOptions::Check() const {
   }
   // sigma 0 (a saturated or constant pixel) would make the normalised difference infinite.
   if (!(min_sigma > 0)) throw std::invalid_argument("background min_sigma: must be > 0");
+  if (!(slope_sigma >= 0 && slope_sigma <= 32)) {
+    throw std::invalid_argument("background slope_sigma: must be in [0, 32] (0: no smoothing)");
+  }
   if (open_radius < 0 || close_radius < 0) throw std::invalid_argument("background morphology radii: must be >= 0");
   if (!(min_blob_fraction >= 0 && min_blob_fraction < 1)) {
     throw std::invalid_argument("background min_blob_fraction: must be in [0, 1)");
@@ -93,8 +108,12 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     if (f.size() != size || f.type() != CV_8UC1) return std::nullopt;
   }
   const int n = static_cast<int>(frames.size());
+  // Screen pixels follow the projection, not L: they take no part in L (the
+  // mean of the other pixels) and are modelled on the screen's own level.
+  const bool own_screen = options.model == "flicker" && !screen.empty() && cv::countNonZero(screen) >= 50;
+  const cv::Mat stage = own_screen ? cv::Mat(screen == 0) : cv::Mat();
   std::vector<double> light(n);
-  for (int i = 0; i < n; ++i) light[i] = cv::mean(frames[i])[0];
+  for (int i = 0; i < n; ++i) light[i] = cv::mean(frames[i], stage)[0];
   double light_mean = 0;
   for (double l : light) light_mean += l / n;
   double light_var = 0;
@@ -120,10 +139,25 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   // small for the noise) falls back to pixels scaling with the light: the
   // whole stage still brightens with a flash, and L must follow it.
   cv::Mat light_pixels;  // CV_8U: pixels whose b is large enough to read L from
+  // The slopes' smoothing, and what it leaves of their noise.
+  const double slope_px = options.slope_sigma * size.width / 320.0;
+  const double se_scale = slope_px > 0 ? GaussianNorm(slope_px, false) : 1.0;
   const auto fit = [&](bool by_regression) {
     cv::Mat b = by_regression ? cv::Mat(sum_l / (n * light_var))
                 : flicker && light_mean > 1 ? cv::Mat(mean / light_mean)
                                             : cv::Mat::zeros(size, CV_64F);
+    if (by_regression && slope_px > 0) {
+      // Over the stage's pixels only: the screens' slopes are another light's.
+      if (stage.empty()) {
+        cv::GaussianBlur(b, b, cv::Size(), slope_px);
+      } else {
+        cv::Mat weight, weighted;
+        stage.convertTo(weight, CV_64F, 1.0 / 255);
+        cv::GaussianBlur(b.mul(weight), weighted, cv::Size(), slope_px);
+        cv::GaussianBlur(weight, weight, cv::Size(), slope_px);
+        b = weighted / cv::max(weight, 1e-6);
+      }
+    }
     cv::Mat a = mean - b * light_mean;
     cv::Mat sq = cv::Mat::zeros(size, CV_64F);
     for (int i = 0; i < n; ++i) {
@@ -147,8 +181,9 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
         const float* sp = m.sigma_.ptr<float>(y);
         uint8_t* lp = light_pixels.ptr<uint8_t>(y);
         for (int x = 0; x < size.width; ++x) {
-          // b's standard error is σ / (sqrt(n) · std(L)).
-          lp[x] = bp[x] > 0.2 && bp[x] > 3 * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
+          // b's standard error is σ / (sqrt(n) · std(L)), times the
+          // smoothing kernel's norm.
+          lp[x] = bp[x] > 0.2 && bp[x] > 3 * se_scale * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
         }
       }
     }
@@ -156,15 +191,64 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     return dof;
   };
   mean.convertTo(m.mean_, CV_32F);
-  if (options.model == "flicker" && !screen.empty() && cv::countNonZero(screen) >= 50) {
-    m.screen_ = screen.clone();
-    // Screen pixels follow the projection, not L: they take no part in
-    // estimating L and are modelled by their own gain.
-  }
+  if (own_screen) m.screen_ = screen.clone();
   int dof = fit(regress);
   if (regress && cv::countNonZero(light_pixels) < kMinLightPixels) {
     regress = false;
     dof = fit(false);
+  }
+  // The screen pixels: the same model on the screen's own level G (the mean
+  // of its pixels; see the header), fitted over the training frames where G
+  // changes (a calibration sweep), else each pixel scales with it.
+  std::vector<double> screen_level(n, 0.0);
+  if (!m.screen_.empty()) {
+    for (int i = 0; i < n; ++i) screen_level[i] = cv::mean(frames[i], m.screen_)[0];
+    double g_mean = 0, g_var = 0;
+    for (double g : screen_level) g_mean += g / n;
+    for (double g : screen_level) g_var += (g - g_mean) * (g - g_mean) / n;
+    m.mean_screen_ = g_mean;
+    const bool screen_regress = g_var > 0.05 && n >= 3;
+    std::vector<cv::Mat> f64(n);
+    cv::Mat sum_g = cv::Mat::zeros(size, CV_64F);
+    for (int i = 0; i < n; ++i) {
+      frames[i].convertTo(f64[i], CV_64F);
+      sum_g += f64[i] * (screen_level[i] - g_mean);
+    }
+    const cv::Mat b = screen_regress ? cv::Mat(sum_g / (n * g_var))
+                      : g_mean > 1   ? cv::Mat(mean / g_mean)
+                                     : cv::Mat::zeros(size, CV_64F);
+    const cv::Mat a = mean - b * g_mean;
+    cv::Mat sq = cv::Mat::zeros(size, CV_64F);
+    for (int i = 0; i < n; ++i) {
+      const cv::Mat r = f64[i] - (a + b * screen_level[i]);
+      sq += r.mul(r);
+    }
+    cv::Mat sigma;
+    cv::sqrt(sq / std::max(1, n - (screen_regress ? 2 : 1)), sigma);
+    sigma = cv::max(sigma, options.min_sigma);
+    cv::Mat a32, b32, s32;
+    a.convertTo(a32, CV_32F);
+    b.convertTo(b32, CV_32F);
+    sigma.convertTo(s32, CV_32F);
+    a32.copyTo(m.a_, m.screen_);
+    b32.copyTo(m.b_, m.screen_);
+    s32.copyTo(m.sigma_, m.screen_);
+    // G is read from the pixels that follow it clearly (every other row and column).
+    for (int y = 0; y < size.height; y += 2) {
+      const uint8_t* sp = m.screen_.ptr<uint8_t>(y);
+      const float* bp = m.b_.ptr<float>(y);
+      const float* gp = m.sigma_.ptr<float>(y);
+      const float* mp = m.mean_.ptr<float>(y);
+      for (int x = 0; x < size.width; x += 2) {
+        if (!sp[x]) continue;
+        const bool clear = screen_regress ? bp[x] > 0.2 && bp[x] > 3 * gp[x] / std::sqrt(n * g_var) : mp[x] > 4;
+        if (!clear) continue;
+        m.screen_samples_.push_back({y, x});
+        m.screen_a_.push_back(m.a_.ptr<float>(y)[x]);
+        m.screen_b_.push_back(bp[x]);
+      }
+    }
+    if (!screen_regress) std::fill(screen_level.begin(), screen_level.end(), -1.0);  // read from the frames
   }
   m.light_pixel_count_ = cv::countNonZero(light_pixels);
   // The light is read from every other row and column: a quarter of the
@@ -188,8 +272,10 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     double pooled_sq = 0, smooth_sq = 0, laplacian_sq = 0;
     size_t count = 0;
     for (int i = 0; i < n; ++i) {
+      const double gain = screen_level[i] >= 0 && m.mean_screen_ > 0 ? screen_level[i] / m.mean_screen_
+                                                                       : m.EstimateScreenGain(frames[i]);
       const cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
-                                     static_cast<float>(m.EstimateScreenGain(frames[i])));
+                                     static_cast<float>(gain));
       if (pool) {
         cv::Mat pooled;
         cv::GaussianBlur(z, pooled, cv::Size(), m.PoolSigmaPx(size.width));
@@ -209,14 +295,7 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     // without noise (the `clean` preset) would otherwise set the thresholds
     // at nothing (the old floor of 1e-3: a thousandth of z or of a grey
     // level), and the faintest tail of the blurred outline would join the body.
-    const auto filtered_norm = [&](double sigma, bool laplacian) {
-      const int half = static_cast<int>(std::ceil(5 * sigma)) + 2;
-      cv::Mat delta = cv::Mat::zeros(2 * half + 1, 2 * half + 1, CV_32F), out;
-      delta.at<float>(half, half) = 1;
-      cv::GaussianBlur(delta, out, cv::Size(), sigma);
-      if (laplacian) cv::Laplacian(out, out, CV_32F);
-      return std::sqrt(out.dot(out));
-    };
+    const auto filtered_norm = GaussianNorm;
     const double rounding = 1 / std::sqrt(12.0);
     // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
     const auto rms = [&](double sum_sq, double floor) {
@@ -238,6 +317,7 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
 cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float screen_gain) const {
   cv::Mat z(frame.size(), CV_32F);
   const float screen_sigma_scale = std::max(1.0f, screen_gain);
+  const float screen_level = screen_gain * static_cast<float>(mean_screen_);
   for (int y = 0; y < frame.rows; ++y) {
     const uint8_t* ip = frame.ptr<uint8_t>(y);
     const float* ap = a_.ptr<float>(y);
@@ -247,7 +327,7 @@ cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float scr
     const uint8_t* scr = screen_.empty() ? nullptr : screen_.ptr<uint8_t>(y);
     float* zp = z.ptr<float>(y);
     for (int x = 0; x < frame.cols; ++x) {
-      zp[x] = scr && scr[x] ? (ip[x] - screen_gain * mp[x]) / (screen_sigma_scale * sp[x])
+      zp[x] = scr && scr[x] ? (ip[x] - (ap[x] + bp[x] * screen_level)) / (screen_sigma_scale * sp[x])
                             : (ip[x] - (ap[x] + bp[x] * light)) / sp[x];
     }
   }
@@ -255,20 +335,14 @@ cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float scr
 }
 
 double BackgroundModel::EstimateScreenGain(const cv::Mat& frame) const {
-  if (screen_.empty()) return 1.0;
-  std::vector<float> ratios;
-  for (int y = 0; y < frame.rows; y += 2) {
-    const uint8_t* ip = frame.ptr<uint8_t>(y);
-    const uint8_t* sp = screen_.ptr<uint8_t>(y);
-    const float* mp = mean_.ptr<float>(y);
-    for (int x = 0; x < frame.cols; x += 2) {
-      if (sp[x] && mp[x] > 4) ratios.push_back(ip[x] / mp[x]);
-    }
+  if (screen_.empty() || screen_samples_.size() < 20 || !(mean_screen_ > 0)) return 1.0;
+  thread_local std::vector<float> levels;
+  levels.resize(screen_samples_.size());
+  for (size_t i = 0; i < screen_samples_.size(); ++i) {
+    const auto [y, x] = screen_samples_[i];
+    levels[i] = (frame.ptr<uint8_t>(y)[x] - screen_a_[i]) / screen_b_[i];
   }
-  if (ratios.size() < 20) return 1.0;
-  auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
-  std::nth_element(ratios.begin(), mid, ratios.end());
-  return *mid;
+  return ValueOfRank(levels, levels.size() / 2) / mean_screen_;
 }
 
 cv::Mat BackgroundModel::Expected(double light) const {

@@ -8,12 +8,23 @@
 //  - "flicker" (default): the screen's light changes the whole stage's
 //    brightness from frame to frame, so each pixel is modelled as
 //    μ(t) = a + b·L(t), L the frame's light level (the mean empty-stage
-//    intensity), with a, b by least squares over the training frames and σ the
-//    residual. At run time L(t) is found from the frame itself — the median
-//    over well-lit pixels of (I − a) / b, robust to the person covering a
-//    minority of them — and pixels are tested against a + b·L(t). With no
-//    light change in the training frames (a short capture between screen
-//    cuts) each pixel is taken to scale with the light: a = 0, b = μ / mean(L).
+//    intensity off the screens), with a, b by least squares over the training
+//    frames and σ the residual. The slope b is smoothed over a few pixels
+//    (`slope_sigma`): the screens' light falls smoothly on the stage, and one
+//    pixel's slope over a dozen frames is mostly noise. At run time L(t) is
+//    found from the frame itself — the median over well-lit pixels of
+//    (I − a) / b, robust to the person covering a minority of them — and
+//    pixels are tested against a + b·L(t). With no light change in the
+//    training frames (a short capture between screen cuts) each pixel is
+//    taken to scale with the light: a = 0, b = μ / mean(L). Empty-stage
+//    frames filmed while the screens sweep their brightness (what `irbench
+//    render` writes) let b learn how much of each pixel's light is the
+//    screens': a screen flash brightens the floor before the screen, not
+//    the back wall.
+//    Screen pixels (seen on a projection screen) follow the same model on the
+//    screen's own level G(t) (the mean of the screen pixels; a per-pixel
+//    offset and slope, as the sensor's black level and tone curve make them),
+//    read from the frame by the same median.
 //    The normalised difference z = (I − μ(t)) / σ is also pooled over a small
 //    Gaussian window, whose noise (measured on the training frames) is several
 //    times lower than a pixel's: clothing only a few grey levels off the wall
@@ -52,6 +63,10 @@ struct BackgroundOptions {
   double pool_sigma = 0.8;
   double pool_threshold = 6.0;
   double pool_weak_threshold = 3.0;  // hysteresis: weaker evidence joined to strong
+  // Flicker model: the Gaussian (sigma, px at 320x240) the per-pixel slopes b
+  // are smoothed with; 0: each pixel's own. Their noise, over which a pixel
+  // must rise to read L from, is scaled by the kernel's norm.
+  double slope_sigma = 2.0;
   // Connected blobs smaller than this fraction of the image are noise,
   // unless they lie within `near_blob_px` (at 320x240) of a blob kept by
   // area and hold at least `near_blob_min_fraction`: a forearm or hand cut
@@ -92,7 +107,7 @@ struct SilhouetteResult {
   cv::Mat darker;          // 255 where the frame is darker than the expected stage (smoothed),
                            // within `mask`'s rows (0 elsewhere: shadow removal reads no more)
   double light_level = 0;  // L(t) (flicker model); the training mean for "plain"
-  double screen_gain = 1;  // the screen pixels' brightness relative to training
+  double screen_gain = 1;  // the screen's level G(t) relative to its training mean
   int blobs_removed = 0;
 };
 
@@ -101,9 +116,10 @@ class BackgroundModel {
   // Learns the model from empty-stage frames (8-bit, one channel, same size).
   // `screen` (optional, CV_8U, 255 where the camera sees a projection screen):
   // those pixels change with the projected content, not with the stage's
-  // light; in the flicker model they get their own gain per frame, the median
-  // of I / μ over the screen pixels (robust to a person covering fewer than
-  // half of them). nullopt when there are no frames or they differ in size.
+  // light; in the flicker model they follow the screen's own level G, read
+  // per frame as the median over the screen pixels (robust to a person
+  // covering fewer than half of them). nullopt when there are no frames or
+  // they differ in size.
   static std::optional<BackgroundModel> Train(const std::vector<cv::Mat>& frames,
                                               const BackgroundOptions& options,
                                               const cv::Mat& screen = cv::Mat());
@@ -127,7 +143,8 @@ class BackgroundModel {
  private:
   BackgroundOptions options_;
   cv::Mat a_, b_, sigma_;
-  // z = (I − μ(t)) / σ, CV_32F; screen pixels: (I − g·μ) / (max(g, 1)·σ).
+  // z = (I − μ(t)) / σ, CV_32F; screen pixels: (I − (a + b·g·Ḡ)) / (max(g, 1)·σ),
+  // g the screen gain and Ḡ the screen's mean level in training.
   cv::Mat Normalised(const cv::Mat& frame, float light, float screen_gain) const;
   double EstimateScreenGain(const cv::Mat& frame) const;
   double PoolSigmaPx(int width) const { return options_.pool_sigma * width / 320.0; }
@@ -136,6 +153,10 @@ class BackgroundModel {
   std::vector<std::pair<int, int>> light_samples_;  // (y, x): those on even rows and columns
   std::vector<float> light_a_, light_b_;             // a_ and b_ there, in the same order
   cv::Mat screen_;        // CV_8U: screen pixels (may be empty)
+  double mean_screen_ = 0;  // the screen pixels' mean level G over the training frames
+  // The pixels G is read from, on even rows and columns, with a and b there.
+  std::vector<std::pair<int, int>> screen_samples_;
+  std::vector<float> screen_a_, screen_b_;
   cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;
   double pooled_noise_ = 1;  // std of the pooled z on the training frames
