@@ -56,6 +56,7 @@ TEST(IlluminationTest, ScreenContentAndIlluminatorsFlickerApart) {
   options.motion = "stand";
   options.frames = 1;
   options.background_frames = 40;
+  options.screen_sweep = false;  // the content's own flicker, not the calibration sweep
   options.out = dir / "seq";
   const fs::path seq = RunRenderJob(options);
   const std::vector<nlohmann::json> truth = ReadLines(seq / "truth/background.jsonl");
@@ -88,6 +89,51 @@ TEST(IlluminationTest, ScreenContentAndIlluminatorsFlickerApart) {
   for (int f = 0; f < 40; ++f) EXPECT_NEAR(recorded[f], mean[f] / ab.sum(), 0.003) << "frame " << f;
   std::printf("side camera, empty stage: mean DN = %.1f m + %.1f s (content share %.2f), residual rms %.2f DN\n",
               ab[0], ab[1], ab[1] / ab.sum(), rms);
+}
+
+// The empty-stage frames are filmed while the screens sweep their brightness:
+// the truth records the ramp's levels, every camera sees the stage brighten
+// with them, and the manifest says so. Without a sensor model (the clean
+// preset) nothing flickers, and there is no sweep.
+TEST(IlluminationTest, EmptyStageFramesSweepTheScreens) {
+  const fs::path dir = FreshTempDir("illum_sweep");
+  for (const std::string sensor : {"thesis", "clean"}) {
+    RenderJobOptions options;
+    options.motion = "stand";
+    options.sensor = sensor;
+    options.frames = 1;
+    options.background_frames = 3;
+    options.out = dir / sensor;
+    const fs::path seq = RunRenderJob(options);
+    const nlohmann::json manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+    const std::vector<nlohmann::json> truth = ReadLines(seq / "truth/background.jsonl");
+    ASSERT_EQ(truth.size(), 3u);
+    const bool sweep = sensor != "clean";
+    if (sweep) {
+      EXPECT_EQ(manifest["background_screen_sweep"]["from"], 0.25);
+      EXPECT_EQ(manifest["background_screen_sweep"]["to"], 1.75);
+    } else {
+      EXPECT_TRUE(manifest["background_screen_sweep"].is_null());
+    }
+    for (const std::string cam : {"front_left", "front_right", "side", "overhead"}) {
+      std::vector<double> means;
+      for (int f = 0; f < 3; ++f) {
+        EXPECT_DOUBLE_EQ(truth[f]["sensor"][cam]["screen"].get<double>(), sweep ? 0.25 + 0.75 * f : 1.0)
+            << cam << " frame " << f;
+        char name[64];
+        std::snprintf(name, sizeof(name), "background/%s/%06d.png", cam.c_str(), f);
+        means.push_back(cv::mean(cv::imread((seq / name).string(), cv::IMREAD_GRAYSCALE))[0]);
+      }
+      if (sweep) {
+        // The screens' light on the stage: at least a third of a grey level
+        // across the ramp, above what the grain does to a frame's mean.
+        EXPECT_GT(means[1], means[0] + 0.15) << cam;
+        EXPECT_GT(means[2], means[1] + 0.15) << cam;
+      } else {
+        EXPECT_EQ(means[0], means[2]) << cam;
+      }
+    }
+  }
 }
 
 // A room lit by one illuminator on a 100 Hz supply, read by a camera whose
@@ -171,6 +217,7 @@ TEST(IlluminationTest, ScreenLitStageFlickersWithTheConfiguredAmplitude) {
     options.motion = "stand";
     options.frames = 1;
     options.background_frames = 300;
+    options.screen_sweep = false;  // the content's own flicker, not the calibration sweep
     options.out = dir / name;
     const fs::path seq = RunRenderJob(options);
     std::vector<double> means;

@@ -133,7 +133,7 @@ std::string CacheKey(const RenderJobOptions& r) {
   std::string key = ToolVersion() + "|" + r.rig + "|" + r.scene + "|" + r.avatar + "|" + r.motion + "|" + r.sensor +
                     "|" + std::to_string(r.seed) + "|" + std::to_string(r.frames.value_or(-1)) + "|" +
                     std::to_string(r.background_frames) + "|" + std::to_string(r.supersample) +
-                    (r.screen_sweep ? "|sweep" : "");
+                    (SweepsScreens(r, in) ? "|sweep" : "");
   for (const fs::path& f : {in.rig_file, in.scene_file, in.avatar_file, in.motion_file}) {
     if (f.empty() || !fs::is_regular_file(f)) continue;
     std::ifstream file(f, std::ios::binary);

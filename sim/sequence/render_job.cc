@@ -1,5 +1,6 @@
 #include "sim/sequence/render_job.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -44,6 +45,10 @@ nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 double ScreenSweepLevel(int index, int count) {
   if (count < 2) return 1.0;
   return kSweepLow + (kSweepHigh - kSweepLow) * index / (count - 1);
+}
+
+bool SweepsScreens(const RenderJobOptions& options, const RenderInputs& in) {
+  return options.screen_sweep && std::find(in.sensor_active.begin(), in.sensor_active.end(), true) != in.sensor_active.end();
 }
 
 RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
@@ -215,7 +220,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["frame_count"] = in.frame_count;
   manifest["background_frame_count"] = options.background_frames;
   manifest["background_screen_sweep"] =
-      options.screen_sweep ? nlohmann::json{{"from", kSweepLow}, {"to", kSweepHigh}} : nlohmann::json(nullptr);
+      SweepsScreens(options, in) ? nlohmann::json{{"from", kSweepLow}, {"to", kSweepHigh}} : nlohmann::json(nullptr);
   nlohmann::json camera_names = nlohmann::json::array();
   for (const Camera& cam : in.rig.cameras) camera_names.push_back(cam.name);
   manifest["cameras"] = camera_names;
@@ -348,7 +353,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const double sweep = options.screen_sweep ? ScreenSweepLevel(f, options.background_frames) : -1.0;
+      const double sweep = SweepsScreens(options, in) ? ScreenSweepLevel(f, options.background_frames) : -1.0;
       const cv::Mat frame = expose(c, all_images[c], cv::Mat(), 1, t, (1ull << 40) + f, sensor_truth, sweep);
       WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }

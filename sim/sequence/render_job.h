@@ -31,6 +31,8 @@ struct RenderJobOptions {
   // calibration sweep an installer runs with the empty theater), so that the
   // tracker can tell the screens' light on the stage from the illuminators'.
   // false: the screens play their content, flickering as during the sequence.
+  // No effect where no camera has a sensor model (`--sensor clean` without
+  // per-camera overrides: no flicker at all).
   bool screen_sweep = true;
   uint64_t seed = 1;
   std::string sensor = "clean";
@@ -68,6 +70,11 @@ struct RenderInputs {
 };
 
 RenderInputs LoadRenderInputs(const RenderJobOptions& options);
+
+// Whether the empty-stage frames show the screens' calibration sweep: asked
+// for, and some camera has a sensor model (a camera without one writes the
+// clean render, whose light does not change).
+bool SweepsScreens(const RenderJobOptions& options, const RenderInputs& in);
 
 // The renderer's options for a job: its supersampling, and shadows unless
 // turned off (default: on for every sensor preset but clean).

@@ -12,6 +12,8 @@ namespace irbench {
 namespace {
 // Fewer pixels than this that follow the light clearly: L cannot be read.
 constexpr int kMinLightPixels = 50;
+// Fewer sampled screen pixels than this: the screen's level cannot be read.
+constexpr size_t kMinScreenSamples = 20;
 
 // The root sum of squares of a Gaussian kernel of `sigma` px (or of its
 // Laplacian), as OpenCV applies them: white noise filtered by it keeps this
@@ -200,7 +202,9 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   }
   // The screen pixels: the same model on the screen's own level G (the mean
   // of its pixels; see the header), fitted over the training frames where G
-  // changes (a calibration sweep), else each pixel scales with it.
+  // changes (a calibration sweep), else each pixel scales with it; so too
+  // when the regression leaves too few pixels to read G from (a change in
+  // training too small for the noise).
   std::vector<double> screen_level(n, 0.0);
   if (!m.screen_.empty()) {
     for (int i = 0; i < n; ++i) screen_level[i] = cv::mean(frames[i], m.screen_)[0];
@@ -208,48 +212,58 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     for (double g : screen_level) g_mean += g / n;
     for (double g : screen_level) g_var += (g - g_mean) * (g - g_mean) / n;
     m.mean_screen_ = g_mean;
-    const bool screen_regress = g_var > 0.05 && n >= 3;
     std::vector<cv::Mat> f64(n);
     cv::Mat sum_g = cv::Mat::zeros(size, CV_64F);
     for (int i = 0; i < n; ++i) {
       frames[i].convertTo(f64[i], CV_64F);
       sum_g += f64[i] * (screen_level[i] - g_mean);
     }
-    const cv::Mat b = screen_regress ? cv::Mat(sum_g / (n * g_var))
-                      : g_mean > 1   ? cv::Mat(mean / g_mean)
-                                     : cv::Mat::zeros(size, CV_64F);
-    const cv::Mat a = mean - b * g_mean;
-    cv::Mat sq = cv::Mat::zeros(size, CV_64F);
-    for (int i = 0; i < n; ++i) {
-      const cv::Mat r = f64[i] - (a + b * screen_level[i]);
-      sq += r.mul(r);
-    }
-    cv::Mat sigma;
-    cv::sqrt(sq / std::max(1, n - (screen_regress ? 2 : 1)), sigma);
-    sigma = cv::max(sigma, options.min_sigma);
-    cv::Mat a32, b32, s32;
-    a.convertTo(a32, CV_32F);
-    b.convertTo(b32, CV_32F);
-    sigma.convertTo(s32, CV_32F);
-    a32.copyTo(m.a_, m.screen_);
-    b32.copyTo(m.b_, m.screen_);
-    s32.copyTo(m.sigma_, m.screen_);
-    // G is read from the pixels that follow it clearly (every other row and column).
-    for (int y = 0; y < size.height; y += 2) {
-      const uint8_t* sp = m.screen_.ptr<uint8_t>(y);
-      const float* bp = m.b_.ptr<float>(y);
-      const float* gp = m.sigma_.ptr<float>(y);
-      const float* mp = m.mean_.ptr<float>(y);
-      for (int x = 0; x < size.width; x += 2) {
-        if (!sp[x]) continue;
-        const bool clear = screen_regress ? bp[x] > 0.2 && bp[x] > 3 * gp[x] / std::sqrt(n * g_var) : mp[x] > 4;
-        if (!clear) continue;
-        m.screen_samples_.push_back({y, x});
-        m.screen_a_.push_back(m.a_.ptr<float>(y)[x]);
-        m.screen_b_.push_back(bp[x]);
+    const auto fit_screen = [&](bool by_regression) {
+      const cv::Mat b = by_regression ? cv::Mat(sum_g / (n * g_var))
+                        : g_mean > 1  ? cv::Mat(mean / g_mean)
+                                      : cv::Mat::zeros(size, CV_64F);
+      const cv::Mat a = mean - b * g_mean;
+      cv::Mat sq = cv::Mat::zeros(size, CV_64F);
+      for (int i = 0; i < n; ++i) {
+        const cv::Mat r = f64[i] - (a + b * screen_level[i]);
+        sq += r.mul(r);
       }
+      cv::Mat sigma;
+      cv::sqrt(sq / std::max(1, n - (by_regression ? 2 : 1)), sigma);
+      sigma = cv::max(sigma, options.min_sigma);
+      cv::Mat a32, b32, s32;
+      a.convertTo(a32, CV_32F);
+      b.convertTo(b32, CV_32F);
+      sigma.convertTo(s32, CV_32F);
+      a32.copyTo(m.a_, m.screen_);
+      b32.copyTo(m.b_, m.screen_);
+      s32.copyTo(m.sigma_, m.screen_);
+      // G is read from the pixels that follow it clearly (every other row
+      // and column): b well above its standard error, or without the
+      // regression, a pixel bright enough to scale.
+      m.screen_samples_.clear();
+      m.screen_a_.clear();
+      m.screen_b_.clear();
+      for (int y = 0; y < size.height; y += 2) {
+        const uint8_t* sp = m.screen_.ptr<uint8_t>(y);
+        const float* bp = m.b_.ptr<float>(y);
+        const float* gp = m.sigma_.ptr<float>(y);
+        const float* mp = m.mean_.ptr<float>(y);
+        for (int x = 0; x < size.width; x += 2) {
+          if (!sp[x] || !(bp[x] > 0.2)) continue;
+          if (by_regression ? bp[x] <= 3 * gp[x] / std::sqrt(n * g_var) : mp[x] <= 4) continue;
+          m.screen_samples_.push_back({y, x});
+          m.screen_a_.push_back(m.a_.ptr<float>(y)[x]);
+          m.screen_b_.push_back(bp[x]);
+        }
+      }
+      return m.screen_samples_.size() >= kMinScreenSamples;
+    };
+    const bool screen_regress = g_var > 0.05 && n >= 3 && fit_screen(true);
+    if (!screen_regress) {
+      fit_screen(false);
+      std::fill(screen_level.begin(), screen_level.end(), -1.0);  // read from the frames
     }
-    if (!screen_regress) std::fill(screen_level.begin(), screen_level.end(), -1.0);  // read from the frames
   }
   m.light_pixel_count_ = cv::countNonZero(light_pixels);
   // The light is read from every other row and column: a quarter of the
@@ -347,7 +361,7 @@ cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float scr
 }
 
 double BackgroundModel::EstimateScreenGain(const cv::Mat& frame) const {
-  if (screen_.empty() || screen_samples_.size() < 20 || !(mean_screen_ > 0)) return 1.0;
+  if (screen_.empty() || screen_samples_.size() < kMinScreenSamples || !(mean_screen_ > 0)) return 1.0;
   thread_local std::vector<float> levels;
   levels.resize(screen_samples_.size());
   for (size_t i = 0; i < screen_samples_.size(); ++i) {

@@ -65,7 +65,9 @@ struct BackgroundOptions {
   double pool_weak_threshold = 3.0;  // hysteresis: weaker evidence joined to strong
   // Flicker model: the Gaussian (sigma, px at 320x240) the per-pixel slopes b
   // are smoothed with; 0: each pixel's own. Their noise, over which a pixel
-  // must rise to read L from, is scaled by the kernel's norm.
+  // must rise to read L from, is scaled by the whole kernel's norm (near the
+  // image's border and the screens, where fewer pixels are averaged, it is
+  // underestimated: a few more pixels pass there).
   double slope_sigma = 2.0;
   // Connected blobs smaller than this fraction of the image are noise,
   // unless they lie within `near_blob_px` (at 320x240) of a blob kept by
@@ -128,14 +130,16 @@ class BackgroundModel {
 
   const BackgroundOptions& options() const { return options_; }
   // Per-pixel model (CV_32F): the expected intensity at light level L is
-  // a + b·L, with residual σ.
+  // a + b·L, with residual σ; at screen pixels (flicker model with a screen)
+  // a + b·G, G the screen's level (screen_gain times its training mean).
   const cv::Mat& a() const { return a_; }
   const cv::Mat& b() const { return b_; }
   const cv::Mat& sigma() const { return sigma_; }
   // Pixels L(t) is read from (0 for the plain model: L is the training mean).
   int light_pixel_count() const { return light_pixel_count_; }
   double mean_light() const { return mean_light_; }
-  // The expected empty-stage image at light level `light`.
+  // The expected empty-stage image at light level `light` (screen pixels
+  // excepted: they follow the screen's level, not L).
   cv::Mat Expected(double light) const;
   // L(t) estimated from `frame` (the training mean for "plain").
   double EstimateLight(const cv::Mat& frame) const;

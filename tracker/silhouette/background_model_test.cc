@@ -174,8 +174,9 @@ TEST(BackgroundModelTest, ScreenPixelsFollowTheScreenLevelWithItsOffset) {
   cv::Mat screen = cv::Mat::zeros(240, 320, CV_8U);
   cv::rectangle(screen, screen_box, 255, cv::FILLED);
   std::normal_distribution<float> noise(0.0f, 1.5f);
+  // The stage follows the screen too: lit by it at 50 per unit of level.
   const auto frame_at = [&](double level) {
-    cv::Mat f = stage.Frame(50, 1.5);
+    cv::Mat f = stage.Frame(50 * level, 1.5);
     for (int y = screen_box.y; y < screen_box.br().y; ++y) {
       for (int x = screen_box.x; x < screen_box.br().x; ++x) {
         const double k = 90.0 - 50.0 * (x - screen_box.x) / screen_box.width;
@@ -202,6 +203,25 @@ TEST(BackgroundModelTest, ScreenPixelsFollowTheScreenLevelWithItsOffset) {
   EXPECT_GT(IoU(a.mask, person), 0.95);
   EXPECT_LT(FalsePositiveRate(a.mask(screen_box), person(screen_box)), 0.005);
   EXPECT_GT(FalsePositiveRate(b.mask(screen_box), person(screen_box)), 0.2);
+  // The stage's slopes on L (the mean of the stage's pixels) beside the
+  // screen: b / mean(b) over the stage, the screen's slopes (about 65 grey
+  // levels per unit of G) kept out of their smoothing.
+  double stage_b_sum = 0;
+  int stage_pixels = 0;
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      if (screen.at<uint8_t>(y, x)) continue;
+      stage_b_sum += stage.b.at<float>(y, x);
+      ++stage_pixels;
+    }
+  }
+  const double stage_b_mean = stage_b_sum / stage_pixels;
+  for (int y = 20; y < 80; y += 10) {
+    for (int x : {screen_box.br().x, screen_box.br().x + 2}) {
+      EXPECT_NEAR(sweep_model->b().at<float>(y, x), stage.b.at<float>(y, x) / stage_b_mean, 0.15)
+          << "x " << x << " y " << y;
+    }
+  }
 }
 
 // A stage the screens light unevenly (the top more than the bottom, over the
