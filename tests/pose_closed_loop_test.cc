@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -202,11 +203,16 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
 }
 
 // Thesis 6.6 reports recovery in 2-3 frames after a loss: scatter the
-// particles over the stage and count frames until the body is found again.
+// particles over the stage and count frames until the body is found again:
+// the root within 8 cm of the truth, or no further from it than a tracker
+// that was never scattered (+2 cm), fed the same features. During the
+// walk-in the tracker's own root error swings between 5 and 17 cm, and a
+// scattering there would otherwise measure that, not the recovery.
 TEST_F(PoseClosedLoopTest, RecoversWithinThreeFramesAfterTheParticlesAreScattered) {
   const SequenceInput input = SequenceInput::Open(*seq_);
   const FrontEnd front_end = FrontEnd::Train(input, {});
   PoseTracker tracker(input.cameras(), input.screens(), {});
+  PoseTracker undisturbed(input.cameras(), input.screens(), {});
   const int inside = FullyInside();
   std::vector<int> recovery;
   int scattered_at = -1;
@@ -219,9 +225,14 @@ TEST_F(PoseClosedLoopTest, RecoversWithinThreeFramesAfterTheParticlesAreScattere
       tracker.Scatter();
       scattered_at = f;
     }
-    const PoseEstimate e = tracker.Step(front_end.Process(f, images), 1.0 / input.fps());
-    on_target = e.tracking && (*truth_)[f]["present"].get<bool>() && RootError(e, (*truth_)[f]) < 0.08;
-    if (scattered_at >= 0 && e.tracking && RootError(e, (*truth_)[f]) < 0.08) {
+    const FrameFeatures features = front_end.Process(f, images);
+    const PoseEstimate e = tracker.Step(features, 1.0 / input.fps());
+    const PoseEstimate reference = undisturbed.Step(features, 1.0 / input.fps());
+    const bool present = (*truth_)[f]["present"].get<bool>();
+    on_target = e.tracking && present && RootError(e, (*truth_)[f]) < 0.08;
+    const double allowed =
+        reference.tracking && present ? std::max(0.08, RootError(reference, (*truth_)[f]) + 0.02) : 0.08;
+    if (scattered_at >= 0 && e.tracking && present && RootError(e, (*truth_)[f]) < allowed) {
       recovery.push_back(f - scattered_at + 1);
       scattered_at = -1;
     } else if (scattered_at >= 0 && f - scattered_at >= 10) {
