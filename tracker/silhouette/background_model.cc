@@ -26,6 +26,59 @@ double GaussianNorm(double sigma, bool laplacian) {
   if (laplacian) cv::Laplacian(out, out, CV_32F);
   return std::sqrt(out.dot(out));
 }
+
+std::pair<double, double> MeanAndVariance(const std::vector<double>& v) {
+  const double n = static_cast<double>(v.size());
+  double mean = 0, var = 0;
+  for (double x : v) mean += x / n;
+  for (double x : v) var += (x - mean) * (x - mean) / n;
+  return {mean, var};
+}
+
+// Per pixel, the slope of the frames' I on a regressor x: by least squares
+// (`cov` = Σ I·(x − x̄) over the n frames, `var` x's variance), or else each
+// pixel scaling with x (μ / x̄), when `scale` and x̄ > 1 (else 0). CV_64F.
+cv::Mat Slopes(bool by_regression, bool scale, const cv::Mat& cov, int n, double var, const cv::Mat& mean,
+               double x_mean) {
+  if (by_regression) return cov / (n * var);
+  if (scale && x_mean > 1) return mean / x_mean;
+  return cv::Mat::zeros(mean.size(), CV_64F);
+}
+
+// The line I ≈ a + b·x per pixel over the frames (CV_64F), given its slopes
+// b: a through the mean, and the residual's σ over `dof` degrees of freedom,
+// floored at `min_sigma`.
+struct PixelLines {
+  cv::Mat a, b, sigma;
+};
+PixelLines FitLines(const std::vector<cv::Mat>& frames, const std::vector<double>& x, double x_mean,
+                    const cv::Mat& mean, const cv::Mat& b, int dof, double min_sigma) {
+  PixelLines lines;
+  lines.b = b;
+  lines.a = mean - b * x_mean;
+  cv::Mat sq = cv::Mat::zeros(mean.size(), CV_64F);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const cv::Mat r = frames[i] - (lines.a + b * x[i]);
+    sq += r.mul(r);
+  }
+  cv::sqrt(sq / dof, lines.sigma);
+  lines.sigma = cv::max(lines.sigma, min_sigma);
+  return lines;
+}
+
+// The median over the sampled pixels of (I − a) / b: the level each one's
+// line reads in `frame`. a and b come in arrays of their own, in the
+// samples' order: one read scattered over the frame instead of three.
+float MedianLevel(const cv::Mat& frame, const std::vector<std::pair<int, int>>& samples,
+                  const std::vector<float>& a, const std::vector<float>& b) {
+  thread_local std::vector<float> levels;
+  levels.resize(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const auto [y, x] = samples[i];
+    levels[i] = (frame.ptr<uint8_t>(y)[x] - a[i]) / b[i];
+  }
+  return ValueOfRank(levels, levels.size() / 2);
+}
 }  // namespace
 
 // By way of a sample: the sample's quantiles about k bracket the value, one
@@ -117,20 +170,17 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   const cv::Mat stage = own_screen ? cv::Mat(screen == 0) : cv::Mat();
   std::vector<double> light(n);
   for (int i = 0; i < n; ++i) light[i] = cv::mean(frames[i], stage)[0];
-  double light_mean = 0;
-  for (double l : light) light_mean += l / n;
-  double light_var = 0;
-  for (double l : light) light_var += (l - light_mean) * (l - light_mean) / n;
+  const auto [light_mean, light_var] = MeanAndVariance(light);
+  std::vector<cv::Mat> f64(n);
+  for (int i = 0; i < n; ++i) frames[i].convertTo(f64[i], CV_64F);
 
   BackgroundModel m;
   m.options_ = options;
   m.mean_light_ = light_mean;
   cv::Mat sum = cv::Mat::zeros(size, CV_64F), sum_l = cv::Mat::zeros(size, CV_64F);
   for (int i = 0; i < n; ++i) {
-    cv::Mat f;
-    frames[i].convertTo(f, CV_64F);
-    sum += f;
-    sum_l += f * (light[i] - light_mean);
+    sum += f64[i];
+    sum_l += f64[i] * (light[i] - light_mean);
   }
   const cv::Mat mean = sum / n;
   // With (almost) no light change in training, b is not identifiable: plain.
@@ -146,9 +196,7 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   const double slope_px = options.slope_sigma * size.width / 320.0;
   const double se_scale = slope_px > 0 ? GaussianNorm(slope_px, false) : 1.0;
   const auto fit = [&](bool by_regression) {
-    cv::Mat b = by_regression ? cv::Mat(sum_l / (n * light_var))
-                : flicker && light_mean > 1 ? cv::Mat(mean / light_mean)
-                                            : cv::Mat::zeros(size, CV_64F);
+    cv::Mat b = Slopes(by_regression, flicker, sum_l, n, light_var, mean, light_mean);
     if (by_regression && slope_px > 0) {
       // Over the stage's pixels only: the screens' slopes are another light's.
       if (stage.empty()) {
@@ -161,21 +209,11 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
         b = weighted / cv::max(weight, 1e-6);
       }
     }
-    cv::Mat a = mean - b * light_mean;
-    cv::Mat sq = cv::Mat::zeros(size, CV_64F);
-    for (int i = 0; i < n; ++i) {
-      cv::Mat f;
-      frames[i].convertTo(f, CV_64F);
-      cv::Mat r = f - (a + b * light[i]);
-      sq += r.mul(r);
-    }
     const int dof = std::max(1, n - (by_regression ? 2 : 1));
-    cv::Mat sigma;
-    cv::sqrt(sq / dof, sigma);
-    a.convertTo(m.a_, CV_32F);
-    b.convertTo(m.b_, CV_32F);
-    sigma = cv::max(sigma, options.min_sigma);
-    sigma.convertTo(m.sigma_, CV_32F);
+    const PixelLines lines = FitLines(f64, light, light_mean, mean, b, dof, options.min_sigma);
+    lines.a.convertTo(m.a_, CV_32F);
+    lines.b.convertTo(m.b_, CV_32F);
+    lines.sigma.convertTo(m.sigma_, CV_32F);
     light_pixels = cv::Mat::zeros(size, CV_8U);
     if (flicker && !by_regression) light_pixels = m.b_ > 0.2;
     if (by_regression) {
@@ -193,7 +231,6 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
     if (!m.screen_.empty()) light_pixels.setTo(0, m.screen_);
     return dof;
   };
-  mean.convertTo(m.mean_, CV_32F);
   if (own_screen) m.screen_ = screen.clone();
   int dof = fit(regress);
   if (regress && cv::countNonZero(light_pixels) < kMinLightPixels) {
@@ -208,33 +245,18 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   std::vector<double> screen_level(n, 0.0);
   if (!m.screen_.empty()) {
     for (int i = 0; i < n; ++i) screen_level[i] = cv::mean(frames[i], m.screen_)[0];
-    double g_mean = 0, g_var = 0;
-    for (double g : screen_level) g_mean += g / n;
-    for (double g : screen_level) g_var += (g - g_mean) * (g - g_mean) / n;
+    const auto [g_mean, g_var] = MeanAndVariance(screen_level);
     m.mean_screen_ = g_mean;
-    std::vector<cv::Mat> f64(n);
     cv::Mat sum_g = cv::Mat::zeros(size, CV_64F);
-    for (int i = 0; i < n; ++i) {
-      frames[i].convertTo(f64[i], CV_64F);
-      sum_g += f64[i] * (screen_level[i] - g_mean);
-    }
+    for (int i = 0; i < n; ++i) sum_g += f64[i] * (screen_level[i] - g_mean);
     const auto fit_screen = [&](bool by_regression) {
-      const cv::Mat b = by_regression ? cv::Mat(sum_g / (n * g_var))
-                        : g_mean > 1  ? cv::Mat(mean / g_mean)
-                                      : cv::Mat::zeros(size, CV_64F);
-      const cv::Mat a = mean - b * g_mean;
-      cv::Mat sq = cv::Mat::zeros(size, CV_64F);
-      for (int i = 0; i < n; ++i) {
-        const cv::Mat r = f64[i] - (a + b * screen_level[i]);
-        sq += r.mul(r);
-      }
-      cv::Mat sigma;
-      cv::sqrt(sq / std::max(1, n - (by_regression ? 2 : 1)), sigma);
-      sigma = cv::max(sigma, options.min_sigma);
+      const cv::Mat b = Slopes(by_regression, true, sum_g, n, g_var, mean, g_mean);
+      const PixelLines lines =
+          FitLines(f64, screen_level, g_mean, mean, b, std::max(1, n - (by_regression ? 2 : 1)), options.min_sigma);
       cv::Mat a32, b32, s32;
-      a.convertTo(a32, CV_32F);
-      b.convertTo(b32, CV_32F);
-      sigma.convertTo(s32, CV_32F);
+      lines.a.convertTo(a32, CV_32F);
+      lines.b.convertTo(b32, CV_32F);
+      lines.sigma.convertTo(s32, CV_32F);
       a32.copyTo(m.a_, m.screen_);
       b32.copyTo(m.b_, m.screen_);
       s32.copyTo(m.sigma_, m.screen_);
@@ -248,7 +270,7 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
         const uint8_t* sp = m.screen_.ptr<uint8_t>(y);
         const float* bp = m.b_.ptr<float>(y);
         const float* gp = m.sigma_.ptr<float>(y);
-        const float* mp = m.mean_.ptr<float>(y);
+        const double* mp = mean.ptr<double>(y);
         for (int x = 0; x < size.width; x += 2) {
           if (!sp[x] || !(bp[x] > 0.2)) continue;
           if (by_regression ? bp[x] <= 3 * gp[x] / std::sqrt(n * g_var) : mp[x] <= 4) continue;
@@ -349,7 +371,6 @@ cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float scr
     const float* ap = a_.ptr<float>(y);
     const float* bp = b_.ptr<float>(y);
     const float* sp = sigma_.ptr<float>(y);
-    const float* mp = mean_.ptr<float>(y);
     const uint8_t* scr = screen_.empty() ? nullptr : screen_.ptr<uint8_t>(y);
     float* zp = z.ptr<float>(y);
     for (int x = 0; x < frame.cols; ++x) {
@@ -362,13 +383,7 @@ cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float scr
 
 double BackgroundModel::EstimateScreenGain(const cv::Mat& frame) const {
   if (screen_.empty() || screen_samples_.size() < kMinScreenSamples || !(mean_screen_ > 0)) return 1.0;
-  thread_local std::vector<float> levels;
-  levels.resize(screen_samples_.size());
-  for (size_t i = 0; i < screen_samples_.size(); ++i) {
-    const auto [y, x] = screen_samples_[i];
-    levels[i] = (frame.ptr<uint8_t>(y)[x] - screen_a_[i]) / screen_b_[i];
-  }
-  return ValueOfRank(levels, levels.size() / 2) / mean_screen_;
+  return MedianLevel(frame, screen_samples_, screen_a_, screen_b_) / mean_screen_;
 }
 
 cv::Mat BackgroundModel::Expected(double light) const {
@@ -377,17 +392,8 @@ cv::Mat BackgroundModel::Expected(double light) const {
 }
 
 double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
-  if (light_pixel_count_ < kMinLightPixels) return mean_light_;
-  thread_local std::vector<float> estimates;
-  estimates.resize(light_samples_.size());
-  // a and b come in arrays of their own: one read scattered over the frame
-  // instead of three.
-  for (size_t i = 0; i < light_samples_.size(); ++i) {
-    const auto [y, x] = light_samples_[i];
-    estimates[i] = (frame.ptr<uint8_t>(y)[x] - light_a_[i]) / light_b_[i];
-  }
-  if (estimates.empty()) return mean_light_;
-  return ValueOfRank(estimates, estimates.size() / 2);
+  if (light_pixel_count_ < kMinLightPixels || light_samples_.empty()) return mean_light_;
+  return MedianLevel(frame, light_samples_, light_a_, light_b_);
 }
 
 SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {

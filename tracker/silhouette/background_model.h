@@ -161,7 +161,6 @@ class BackgroundModel {
   // The pixels G is read from, on even rows and columns, with a and b there.
   std::vector<std::pair<int, int>> screen_samples_;
   std::vector<float> screen_a_, screen_b_;
-  cv::Mat mean_;          // CV_32F: the training mean μ
   double mean_light_ = 0;
   double pooled_noise_ = 1;  // std of the pooled z on the training frames
   // On the training frames, grey levels: the rms of I − μ(t) smoothed by
