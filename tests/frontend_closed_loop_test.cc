@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "ci/score/silhouette_score.h"
 #include "sim/sequence/render_job.h"
 #include "tests/test_util.h"
 #include "tests/true_body.h"
@@ -37,31 +38,41 @@ double IoU(const cv::Mat& a, const cv::Mat& b) {
   return u == 0 ? 1.0 : double(cv::countNonZero(a & b)) / u;
 }
 
+// The IoU the silhouette would have with the pixels within one pixel of the
+// true outline (SilhouetteCounts' "near" pixels) set right and the rest as
+// they are: how much of the error is the outline's pixel.
+double OutlineRightIoU(const cv::Mat& truth, const cv::Mat& silhouette) {
+  const SilhouetteCounts c = CountSilhouette(truth, silhouette);
+  return double(c.intersection() + c.missed_near) / std::max(1L, c.truth + c.false_far);
+}
+
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-// Renders `person` on theater4 with the thesis preset: a few frames of the
-// atom tour, time-warped so they span many arm postures.
-fs::path RenderThesis(const fs::path& dir, const std::string& person, int frames) {
+// Renders `person` on theater4 with a sensor preset (default: the thesis
+// preset): a few frames of the atom tour, time-warped so they span many arm
+// postures.
+fs::path RenderThesis(const fs::path& dir, const std::string& person, int frames,
+                      const std::string& sensor = "thesis") {
   const fs::path session = dir / "tour.json";
   WriteText(session, R"({"format": "irbench.session/1", "items": [{"motion": "atom_tour", "speed": 6}]})");
   RenderJobOptions options;
   options.rig = "theater4";
   options.avatar = person;
   options.motion = session.string();
-  options.sensor = "thesis";
+  options.sensor = sensor;
   options.frames = frames;
   options.background_frames = 12;
   options.seed = 7;
-  options.out = dir / person;
+  options.out = dir / (person + "_" + sensor);
   return RunRenderJob(options);
 }
 
 TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
   const fs::path dir = FreshTempDir("frontend_silhouettes");
-  std::vector<double> iou_flicker, iou_plain, iou_raw;
+  std::vector<double> iou_flicker, iou_plain, iou_raw, iou_outline_right;
   long fp_before = 0, fp_after = 0, body_before = 0, body_after = 0, truth_pixels = 0;
   for (const std::string person : {"p1", "p2", "p3", "p4", "p5"}) {
     const fs::path seq = RenderThesis(dir, person, 4);
@@ -83,6 +94,7 @@ TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
         const cv::Mat cleaned = shadows->Remove(frame, sil, r.darker);
         iou_raw.push_back(IoU(sil, truth));
         iou_flicker.push_back(IoU(cleaned, truth));
+        iou_outline_right.push_back(OutlineRightIoU(truth, cleaned));
         const SilhouetteResult rp = plain->Segment(frame);
         iou_plain.push_back(IoU(shadows->Remove(frame, rp.mask, rp.darker), truth));
         fp_before += cv::countNonZero(sil & ~truth);
@@ -97,6 +109,8 @@ TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
   std::printf("silhouette IoU, median over %zu camera-frames: flicker model %.3f (before shadow removal %.3f), "
               "thesis plain model %.3f\n",
               iou_flicker.size(), Median(iou_flicker), Median(iou_raw), Median(iou_plain));
+  std::printf("the same with the pixels within a pixel of the true outline set right (the rest as found): %.3f\n",
+              Median(iou_outline_right));
   std::printf("truth pixels %ld: found %ld (%.1f%%), false foreground after %ld (%.1f%% of truth)\n", truth_pixels,
               body_after, 100.0 * body_after / std::max(1L, truth_pixels), fp_after,
               100.0 * fp_after / std::max(1L, truth_pixels));
@@ -112,9 +126,58 @@ TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
   // 0.863 (clothing as grey as the floor behind it: p3's and p5's legs) and
   // the overhead 0.667 (body shadows on the floor, small silhouettes).
   EXPECT_GE(Median(iou_flicker), 0.85);
+  // What is left lies on the outline: with its pixel right, 0.971 (issue 6's
+  // bar, 0.92, is out of reach of the outline as found; see the test below).
+  EXPECT_GE(Median(iou_outline_right), 0.95);
   EXPECT_GE(Median(iou_flicker) - Median(iou_plain), 0.2);
   EXPECT_LE(double(fp_after), 0.30 * double(fp_before));
   EXPECT_LE(1 - double(body_after) / std::max(1L, body_before), 0.03);
+}
+
+// The ceiling of the outline as the intensities show it: the same frames
+// rendered with the `clean` preset (no noise, flicker or lens blur, and by its
+// default no soft shadows). The body's brightness falls towards its rims (a
+// rounded body lit from near the cameras), so its outermost half pixel is
+// barely brighter than the stage even here: the median stays under issue 6's
+// bar of 0.92 on these frames too, and the outline's pixel is still nearly
+// all of what is missing.
+TEST(FrontendClosedLoopTest, SilhouettesOnNoiseFreeFrames) {
+  const fs::path dir = FreshTempDir("frontend_noise_free");
+  std::vector<double> iou, iou_outline_right;
+  std::vector<std::vector<double>> by_camera(4);
+  std::vector<std::string> camera_names(4);
+  for (const std::string person : {"p1", "p2", "p3", "p4", "p5"}) {
+    const fs::path seq = RenderThesis(dir, person, 4, "clean");
+    const SequenceInput in = SequenceInput::Open(seq);
+    ASSERT_EQ(in.cameras().size(), by_camera.size());
+    const FrontEnd front_end = FrontEnd::Train(in, {});
+    for (int f = 0; f < in.frame_count(); ++f) {
+      std::vector<cv::Mat> images;
+      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const FrameFeatures features = front_end.Process(f, images);
+      for (size_t c = 0; c < in.cameras().size(); ++c) {
+        const cv::Mat truth = TruthMask(seq, in.cameras()[c].name, f);
+        iou.push_back(IoU(features.cameras[c].silhouette, truth));
+        iou_outline_right.push_back(OutlineRightIoU(truth, features.cameras[c].silhouette));
+        by_camera[c].push_back(iou.back());
+        camera_names[c] = in.cameras()[c].name;
+      }
+    }
+    fs::remove_all(seq);
+  }
+  std::string per_camera;
+  for (size_t c = 0; c < by_camera.size(); ++c) {
+    char item[64];
+    std::snprintf(item, sizeof(item), "%s%s %.3f", c ? ", " : "", camera_names[c].c_str(), Median(by_camera[c]));
+    per_camera += item;
+  }
+  std::printf("noise-free frames: silhouette IoU median over %zu camera-frames %.3f (%s); with the outline's pixel "
+              "set right %.3f\n",
+              iou.size(), Median(iou), per_camera.c_str(), Median(iou_outline_right));
+  // Measured 2026-11-26: 0.897 (front 0.901 and 0.886, overhead 0.844, side
+  // 0.915); with the outline's pixel right 0.988. Floors under them.
+  EXPECT_GE(Median(iou), 0.87);
+  EXPECT_GE(Median(iou_outline_right), 0.97);
 }
 
 Eigen::Vector3d Joint(const nlohmann::json& frame, const std::string& name) {
