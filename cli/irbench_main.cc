@@ -118,6 +118,10 @@ int main(int argc, char** argv) {
                         "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)")
       ->capture_default_str();
   track_cmd->add_flag("--keep-shadows", track_keep_shadows, "skip the edge-based shadow removal");
+  track_cmd->add_option("--shadow-edge-scale", track.shadow_edge_scale,
+                        "shadow removal's edge thresholds times this, 0.25-8 (1: set for the thesis preset's\n"
+                        "washed-out images; 2 for the clean preset with --shadows on)")
+      ->capture_default_str();
   track_cmd->add_flag("--overlays", track.overlays, "also write debug overlays (PNG, colour)");
   track_cmd->add_flag("--ply", track.ply, "also write the voxel and polyhedral hulls per frame as PLY");
   track_cmd->add_option("--hull-missing-views", track.hull_missing_views,

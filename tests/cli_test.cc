@@ -287,6 +287,14 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
     ++count;
   }
   EXPECT_EQ(count, 2);
+  // The shadow edge scale is recorded with the run (1 unless given).
+  const Result scaled = RunIrbench(
+      {"track", (dir / "seq").string(), "--stage", "features", "--shadow-edge-scale", "2", "--out",
+       (dir / "scaled").string()},
+      dir);
+  ASSERT_EQ(scaled.exit_code, 0) << scaled.err;
+  EXPECT_EQ(nlohmann::json::parse(ReadText(dir / "scaled" / "track.json"))["shadow_edge_scale"], 2.0);
+  EXPECT_EQ(nlohmann::json::parse(ReadText(track / "track.json"))["shadow_edge_scale"], 1.0);
   // The default stage, pose: every frame tracked has the nine scored joints.
   const Result pose = RunIrbench({"track", (dir / "seq").string(), "--out", (dir / "pose").string()}, dir);
   ASSERT_EQ(pose.exit_code, 0) << pose.err;
@@ -318,6 +326,8 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
          "nosuch.yml"},
         {{"track", (dir / "seq").string(), "--background-model", "mog", "--out", (dir / "t3").string()},
          "--background-model"},
+        {{"track", (dir / "seq").string(), "--shadow-edge-scale", "0", "--out", (dir / "t6").string()},
+         "--shadow-edge-scale"},
         {{"track", (dir / "missing").string()}, "no such sequence folder"},
         {{"track", (dir / "nobg").string()}, "no empty-stage frames"}}) {
     const Result bad = RunIrbench(args, dir);
@@ -325,7 +335,7 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
-  for (const char* name : {"t2", "t3", "t4", "t5"}) EXPECT_FALSE(fs::exists(dir / name));
+  for (const char* name : {"t2", "t3", "t4", "t5", "t6"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
   // An output that would replace the sequence or land in what it reads.
   for (const auto& [out, expected] : {std::pair<fs::path, std::string>{dir / "seq", "would replace the sequence"},

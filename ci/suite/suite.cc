@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -37,6 +38,7 @@ struct Scenario {
   std::string background_model = "flicker";
   bool remove_shadows = true;
   int hull_missing_views = 0;
+  double shadow_edge_scale = 1.0;
   int particles = 100;
   std::map<std::string, Bound> thresholds;
 };
@@ -90,13 +92,17 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
     sc.render.screen_sweep = s.GetBool("background_screen_sweep", true);
     if (s.Has("track")) {
       const JsonNode t = s["track"];
-      t.CheckKeys({"background_model", "remove_shadows", "hull_missing_views", "particles"});
+      t.CheckKeys({"background_model", "remove_shadows", "hull_missing_views", "shadow_edge_scale", "particles"});
       sc.background_model = t.GetString("background_model", "flicker");
       if (sc.background_model != "flicker" && sc.background_model != "plain") {
         t["background_model"].Fail("must be flicker or plain");
       }
       sc.remove_shadows = t.Has("remove_shadows") ? t["remove_shadows"].raw().get<bool>() : true;
       sc.hull_missing_views = t.GetInt("hull_missing_views", 0);
+      sc.shadow_edge_scale = t.GetDouble("shadow_edge_scale", 1.0);
+      if (!(sc.shadow_edge_scale >= 0.25 && sc.shadow_edge_scale <= 8)) {
+        t["shadow_edge_scale"].Fail("must be in 0.25..8");
+      }
       sc.particles = t.GetInt("particles", 100);
       if (sc.particles < 1) t["particles"].Fail("must be at least 1");
     }
@@ -165,11 +171,15 @@ std::map<std::string, double> RunScenario(const Scenario& sc, const std::string&
   }
   TrackJobOptions track;
   track.sequence = seq;
-  track.out = seq / ("track-" + sc.background_model + (sc.remove_shadows ? "" : "-shadows") + "-h" +
+  // The edge scale only when not 1: the folders of earlier runs keep their names.
+  char edge_scale[32] = "";
+  if (sc.shadow_edge_scale != 1.0) std::snprintf(edge_scale, sizeof(edge_scale), "-e%g", sc.shadow_edge_scale);
+  track.out = seq / ("track-" + sc.background_model + (sc.remove_shadows ? "" : "-shadows") + edge_scale + "-h" +
                      std::to_string(sc.hull_missing_views) + "-p" + std::to_string(sc.particles));
   track.background_model = sc.background_model;
   track.remove_shadows = sc.remove_shadows;
   track.hull_missing_views = sc.hull_missing_views;
+  track.shadow_edge_scale = sc.shadow_edge_scale;
   track.particles = sc.particles;
   track.overwrite = true;
   RunTrackJob(track);

@@ -105,6 +105,11 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   FrontEndOptions fe_options;
   fe_options.background.model = options.background_model;
   fe_options.remove_shadows = options.remove_shadows;
+  if (!(options.shadow_edge_scale >= 0.25 && options.shadow_edge_scale <= 8)) {
+    throw InputError("", "--shadow-edge-scale", "must be in 0.25..8");
+  }
+  fe_options.shadow.canny_low *= options.shadow_edge_scale;
+  fe_options.shadow.canny_high *= options.shadow_edge_scale;
   try {
     fe_options.background.Check();
   } catch (const std::invalid_argument& e) {
@@ -324,6 +329,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                          {"seed", options.seed},
                          {"background_model", options.background_model},
                          {"remove_shadows", options.remove_shadows},
+                         {"shadow_edge_scale", options.shadow_edge_scale},
                          {"hull_missing_views", options.hull_missing_views},
                          {"frames", frames},
                          {"train_ms", train_ms}};

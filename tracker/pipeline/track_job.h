@@ -40,6 +40,11 @@ struct TrackJobOptions {
   std::filesystem::path rest_model;
   std::string background_model = "flicker";  // or "plain" (thesis 3.1)
   bool remove_shadows = true;
+  // Shadow removal's Canny thresholds (ShadowOptions) times this: they are
+  // set for the washed-out `thesis` images; images of more contrast with
+  // soft shadows (the `clean` preset with --shadows on: 2) need them higher,
+  // or the penumbra next to the feet passes as an edge (docs/tracker.md).
+  double shadow_edge_scale = 1.0;
   bool overlays = false;
   bool ply = false;
   int hull_missing_views = 0;  // voxel hull: cameras allowed to disagree (0: the thesis's hull; 1)
