@@ -295,6 +295,16 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
   ASSERT_EQ(scaled.exit_code, 0) << scaled.err;
   EXPECT_EQ(nlohmann::json::parse(ReadText(dir / "scaled" / "track.json"))["shadow_edge_scale"], 2.0);
   EXPECT_EQ(nlohmann::json::parse(ReadText(track / "track.json"))["shadow_edge_scale"], 1.0);
+  // ... and reaches shadow removal: on the thesis preset doubled thresholds
+  // lose body edges, so some silhouette changes.
+  int changed = 0;
+  for (const auto& cam : fs::directory_iterator(track / "silhouettes")) {
+    for (const auto& png : fs::directory_iterator(cam.path())) {
+      const fs::path other = dir / "scaled" / "silhouettes" / cam.path().filename() / png.path().filename();
+      changed += ReadText(png.path()) != ReadText(other);
+    }
+  }
+  EXPECT_GT(changed, 0);
   // The default stage, pose: every frame tracked has the nine scored joints.
   const Result pose = RunIrbench({"track", (dir / "seq").string(), "--out", (dir / "pose").string()}, dir);
   ASSERT_EQ(pose.exit_code, 0) << pose.err;
@@ -484,6 +494,12 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   const Result typo = RunIrbench({"suite", "run", (dir / "typo.json").string(), "--cache", (dir / "cache").string()}, dir);
   EXPECT_EQ(typo.exit_code, 2) << typo.err;
   EXPECT_NE(typo.err.find("typo.json: scenarios[0].thresholds.silhouette_iou"), std::string::npos) << typo.err;
+  WriteText(dir / "scale.json", R"({"format": "irbench.suite/1", "name": "t", "scenarios": [
+    {"name": "a", "track": {"shadow_edge_scale": 9}}]})");
+  const Result scale = RunIrbench({"suite", "run", (dir / "scale.json").string(), "--cache", (dir / "cache").string()}, dir);
+  EXPECT_EQ(scale.exit_code, 2) << scale.err;
+  EXPECT_NE(scale.err.find("scale.json: scenarios[0].track.shadow_edge_scale: must be in 0.25..8"), std::string::npos)
+      << scale.err;
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

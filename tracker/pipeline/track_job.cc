@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -105,8 +106,11 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   FrontEndOptions fe_options;
   fe_options.background.model = options.background_model;
   fe_options.remove_shadows = options.remove_shadows;
-  if (!(options.shadow_edge_scale >= 0.25 && options.shadow_edge_scale <= 8)) {
-    throw InputError("", "--shadow-edge-scale", "must be in 0.25..8");
+  if (!(options.shadow_edge_scale >= kMinShadowEdgeScale && options.shadow_edge_scale <= kMaxShadowEdgeScale)) {
+    char message[96];
+    std::snprintf(message, sizeof(message), "'%g': must be in %g..%g", options.shadow_edge_scale,
+                  kMinShadowEdgeScale, kMaxShadowEdgeScale);
+    throw InputError("", "--shadow-edge-scale", message);
   }
   fe_options.shadow.canny_low *= options.shadow_edge_scale;
   fe_options.shadow.canny_high *= options.shadow_edge_scale;

@@ -29,6 +29,9 @@
 
 namespace irbench {
 
+// The range of TrackJobOptions::shadow_edge_scale (the CLI and suites check it).
+constexpr double kMinShadowEdgeScale = 0.25, kMaxShadowEdgeScale = 8;
+
 struct TrackJobOptions {
   std::filesystem::path sequence;
   std::filesystem::path out;  // default: <sequence>/track
@@ -44,7 +47,7 @@ struct TrackJobOptions {
   // set for the washed-out `thesis` images; images of more contrast with
   // soft shadows (the `clean` preset with --shadows on: 2) need them higher,
   // or the penumbra next to the feet passes as an edge (docs/tracker.md).
-  double shadow_edge_scale = 1.0;
+  double shadow_edge_scale = 1.0;  // kMinShadowEdgeScale..kMaxShadowEdgeScale
   bool overlays = false;
   bool ply = false;
   int hull_missing_views = 0;  // voxel hull: cameras allowed to disagree (0: the thesis's hull; 1)
