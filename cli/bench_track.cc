@@ -37,9 +37,7 @@ std::vector<TrackBenchRow> RunTrackBench(RenderJobOptions render, int frames, in
   options.polyhedral_hull = true;  // timed too, though the front end builds it only on request
   const FrontEnd front_end = FrontEnd::Train(input, options);
   std::vector<std::vector<cv::Mat>> images(input.frame_count());
-  for (int f = 0; f < input.frame_count(); ++f) {
-    for (size_t c = 0; c < input.cameras().size(); ++c) images[f].push_back(input.Frame(static_cast<int>(c), f));
-  }
+  for (int f = 0; f < input.frame_count(); ++f) images[f] = input.FrameSet(f);
   // The stages irbench track runs (all but the polyhedral hull).
   auto tracked_ms = [](const FrameFeatures& f) { return f.ms_silhouettes + f.ms_axes + f.ms_polygons + f.ms_voxels; };
   std::vector<double> sil, axes, polygons, voxels, polyhedral, tracked, total;

@@ -166,8 +166,7 @@ TEST(FrontendClosedLoopTest, SilhouettesOnNoiseFreeFrames) {
     ASSERT_EQ(in.cameras().size(), by_camera.size());
     const FrontEnd front_end = FrontEnd::Train(in, SilhouettesOnly());
     for (int f = 0; f < in.frame_count(); ++f) {
-      std::vector<cv::Mat> images;
-      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const std::vector<cv::Mat> images = in.FrameSet(f);
       const FrameFeatures features = front_end.Process(f, images);
       for (size_t c = 0; c < in.cameras().size(); ++c) {
         const cv::Mat truth = TruthMask(seq, in.cameras()[c].name, f);
@@ -212,8 +211,7 @@ TEST(FrontendClosedLoopTest, SoftShadowsWithoutNoiseNeedTheEdgeThresholdsScaled)
     const FrontEnd thesis_edges = FrontEnd::Train(in, SilhouettesOnly());
     const FrontEnd scaled_edges = FrontEnd::Train(in, scaled);
     for (int f = 0; f < in.frame_count(); ++f) {
-      std::vector<cv::Mat> images;
-      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const std::vector<cv::Mat> images = in.FrameSet(f);
       const FrameFeatures a = thesis_edges.Process(f, images), b = scaled_edges.Process(f, images);
       for (size_t c = 0; c < in.cameras().size(); ++c) {
         const cv::Mat truth = TruthMask(seq, in.cameras()[c].name, f);
@@ -273,8 +271,7 @@ TEST(FrontendClosedLoopTest, ArmAxisFromThesisSilhouettes) {
         raised |= Joint(frame, side + "_wrist").z() > Joint(frame, side + "_shoulder").z() - 0.1;
       }
       if (!raised || f % 3 != 0) continue;
-      std::vector<cv::Mat> images;
-      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const std::vector<cv::Mat> images = in.FrameSet(f);
       const FrameFeatures features = front_end.Process(f, images);
       int arm_points = 0;
       for (const AxisPoint3d& p : features.axis3d) {
@@ -334,8 +331,7 @@ TEST(FrontendClosedLoopTest, VoxelHullFromThesisSilhouettes) {
     tolerant_options.max_missing_views = 1;
     const VoxelCarver tolerant(in.cameras(), tolerant_options);
     for (int f = 0; f < in.frame_count(); ++f) {
-      std::vector<cv::Mat> images;
-      for (size_t c = 0; c < in.cameras().size(); ++c) images.push_back(in.Frame(static_cast<int>(c), f));
+      const std::vector<cv::Mat> images = in.FrameSet(f);
       const FrameFeatures features = front_end.Process(f, images);
       ASSERT_TRUE(features.voxels);
       const irbench::testing::BodyMesh body = irbench::testing::PosedBody(truth_inputs, f);

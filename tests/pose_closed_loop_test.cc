@@ -120,8 +120,7 @@ TEST_F(PoseClosedLoopTest, JointsPointingAndStartFromAnEmptyStage) {
   int rest_correct = 0, rest_total = 0;
   std::vector<int> first_tracking(seeds.size(), -1), first_root(seeds.size(), -1);
   for (int f = 0; f < input.frame_count(); ++f) {
-    std::vector<cv::Mat> images;
-    for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
+    const std::vector<cv::Mat> images = input.FrameSet(f);
     const FrameFeatures features = front_end.Process(f, images);
     for (size_t s = 0; s < seeds.size(); ++s) {
       const PoseEstimate e = trackers[s].Step(features, 1.0 / input.fps());
@@ -218,8 +217,7 @@ TEST_F(PoseClosedLoopTest, RecoversWithinThreeFramesAfterTheParticlesAreScattere
   int scattered_at = -1;
   bool on_target = false;  // the previous frame's root within 8 cm
   for (int f = 0; f < input.frame_count(); ++f) {
-    std::vector<cv::Mat> images;
-    for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
+    const std::vector<cv::Mat> images = input.FrameSet(f);
     // Scatter a tracker that was on target, every 25 frames once inside.
     if (f > inside + 15 && (f - inside) % 25 == 0 && on_target && scattered_at < 0) {
       tracker.Scatter();

@@ -218,6 +218,12 @@ cv::Mat SequenceInput::Load(const fs::path& path, int camera) const {
 
 cv::Mat SequenceInput::Frame(int camera, int frame) const { return Load(FramePath(camera, frame), camera); }
 
+std::vector<cv::Mat> SequenceInput::FrameSet(int frame) const {
+  std::vector<cv::Mat> out;
+  for (size_t c = 0; c < cameras_.size(); ++c) out.push_back(Frame(static_cast<int>(c), frame));
+  return out;
+}
+
 cv::Mat SequenceInput::Background(int camera, int index) const {
   return Load(BackgroundPath(camera, index), camera);
 }

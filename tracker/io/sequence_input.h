@@ -34,6 +34,8 @@ class SequenceInput {
   // 8-bit single-channel images (16-bit frames are scaled to 8 bits). Throws
   // InputError for an unreadable file or one of the wrong size.
   cv::Mat Frame(int camera, int frame) const;
+  // Every camera's frame `frame`, in the cameras' order (a frame-set).
+  std::vector<cv::Mat> FrameSet(int frame) const;
   cv::Mat Background(int camera, int index) const;
   std::vector<cv::Mat> Backgrounds(int camera) const;
 

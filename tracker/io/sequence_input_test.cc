@@ -60,6 +60,13 @@ TEST_F(SequenceInputTest, CalibrationReproducesTheTruthPixels) {
   EXPECT_EQ(f.cols, in.cameras()[2].width);
   EXPECT_EQ(b.rows, in.cameras()[3].height);
   EXPECT_EQ(in.Backgrounds(0).size(), 2u);
+  // A frame-set: every camera's frame, in the cameras' order.
+  const std::vector<cv::Mat> set = in.FrameSet(1);
+  ASSERT_EQ(set.size(), in.cameras().size());
+  for (size_t c = 0; c < set.size(); ++c) {
+    EXPECT_EQ(cv::norm(set[c], in.Frame(static_cast<int>(c), 1), cv::NORM_INF), 0) << in.cameras()[c].name;
+  }
+  EXPECT_NE(cv::norm(set[0], in.Frame(0, 0), cv::NORM_INF), 0);  // frame 1, not 0: the person moved
 }
 
 TEST_F(SequenceInputTest, BadFoldersNameTheFile) {

@@ -187,8 +187,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   auto last_report = start;
   for (int f = 0; f < frames; ++f) {
     ThrowIfCancelled();
-    std::vector<cv::Mat> images;
-    for (size_t c = 0; c < input.cameras().size(); ++c) images.push_back(input.Frame(static_cast<int>(c), f));
+    const std::vector<cv::Mat> images = input.FrameSet(f);
     const FrameFeatures features = front_end.Process(f, images);
     std::optional<PoseEstimate> pose;
     if (pose_tracker) pose = pose_tracker->Step(features, 1.0 / input.fps());
