@@ -100,10 +100,8 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
       sc.remove_shadows = t.Has("remove_shadows") ? t["remove_shadows"].raw().get<bool>() : true;
       sc.hull_missing_views = t.GetInt("hull_missing_views", 0);
       sc.shadow_edge_scale = t.GetDouble("shadow_edge_scale", 1.0);
-      if (!(sc.shadow_edge_scale >= kMinShadowEdgeScale && sc.shadow_edge_scale <= kMaxShadowEdgeScale)) {
-        char message[64];
-        std::snprintf(message, sizeof(message), "must be in %g..%g", kMinShadowEdgeScale, kMaxShadowEdgeScale);
-        t["shadow_edge_scale"].Fail(message);
+      if (const std::string problem = ShadowEdgeScaleProblem(sc.shadow_edge_scale); !problem.empty()) {
+        t["shadow_edge_scale"].Fail(problem);
       }
       sc.particles = t.GetInt("particles", 100);
       if (sc.particles < 1) t["particles"].Fail("must be at least 1");

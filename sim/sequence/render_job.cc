@@ -148,6 +148,7 @@ FrameTruth ComputeFrameTruth(const RenderInputs& inputs,
 fs::path RunRenderJob(const RenderJobOptions& options) {
   // 1. Everything from outside is checked before anything is created.
   const RenderInputs in = LoadRenderInputs(options);
+  const bool sweep_screens = SweepsScreens(options, in);
   fs::path out = options.out;
   if (out.empty()) {
     out = DataRoot() / "renders" /
@@ -220,7 +221,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["frame_count"] = in.frame_count;
   manifest["background_frame_count"] = options.background_frames;
   manifest["background_screen_sweep"] =
-      SweepsScreens(options, in) ? nlohmann::json{{"from", kSweepLow}, {"to", kSweepHigh}} : nlohmann::json(nullptr);
+      sweep_screens ? nlohmann::json{{"from", kSweepLow}, {"to", kSweepHigh}} : nlohmann::json(nullptr);
   nlohmann::json camera_names = nlohmann::json::array();
   for (const Camera& cam : in.rig.cameras) camera_names.push_back(cam.name);
   manifest["cameras"] = camera_names;
@@ -352,8 +353,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     renderer.RenderAll(&all_images, need_depth);
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
+    const double sweep = sweep_screens ? ScreenSweepLevel(f, options.background_frames) : -1.0;
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const double sweep = SweepsScreens(options, in) ? ScreenSweepLevel(f, options.background_frames) : -1.0;
       const cv::Mat frame = expose(c, all_images[c], cv::Mat(), 1, t, (1ull << 40) + f, sensor_truth, sweep);
       WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }

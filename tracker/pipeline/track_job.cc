@@ -98,6 +98,14 @@ const char* Part3dName(BodyPart part) {
 
 }  // namespace
 
+std::string ShadowEdgeScaleProblem(double scale) {
+  constexpr double kMin = 0.25, kMax = 8;
+  if (scale >= kMin && scale <= kMax) return "";
+  char message[64];
+  std::snprintf(message, sizeof(message), "must be in %g..%g", kMin, kMax);
+  return message;
+}
+
 fs::path RunTrackJob(const TrackJobOptions& options) {
   if (options.stage != "features" && options.stage != "pose") {
     throw InputError("", "--stage", "'" + options.stage + "': expected features or pose");
@@ -106,11 +114,10 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   FrontEndOptions fe_options;
   fe_options.background.model = options.background_model;
   fe_options.remove_shadows = options.remove_shadows;
-  if (!(options.shadow_edge_scale >= kMinShadowEdgeScale && options.shadow_edge_scale <= kMaxShadowEdgeScale)) {
-    char message[96];
-    std::snprintf(message, sizeof(message), "'%g': must be in %g..%g", options.shadow_edge_scale,
-                  kMinShadowEdgeScale, kMaxShadowEdgeScale);
-    throw InputError("", "--shadow-edge-scale", message);
+  if (const std::string problem = ShadowEdgeScaleProblem(options.shadow_edge_scale); !problem.empty()) {
+    char value[48];
+    std::snprintf(value, sizeof(value), "'%g': ", options.shadow_edge_scale);
+    throw InputError("", "--shadow-edge-scale", value + problem);
   }
   fe_options.shadow.canny_low *= options.shadow_edge_scale;
   fe_options.shadow.canny_high *= options.shadow_edge_scale;

@@ -29,8 +29,9 @@
 
 namespace irbench {
 
-// The range of TrackJobOptions::shadow_edge_scale (the CLI and suites check it).
-constexpr double kMinShadowEdgeScale = 0.25, kMaxShadowEdgeScale = 8;
+// What is wrong with a TrackJobOptions::shadow_edge_scale ("must be in
+// 0.25..8"), or "" when it is in range: the track job and suites check it.
+std::string ShadowEdgeScaleProblem(double scale);
 
 struct TrackJobOptions {
   std::filesystem::path sequence;
@@ -47,7 +48,7 @@ struct TrackJobOptions {
   // set for the washed-out `thesis` images; images of more contrast with
   // soft shadows (the `clean` preset with --shadows on: 2) need them higher,
   // or the penumbra next to the feet passes as an edge (docs/tracker.md).
-  double shadow_edge_scale = 1.0;  // kMinShadowEdgeScale..kMaxShadowEdgeScale
+  double shadow_edge_scale = 1.0;  // 0.25..8 (ShadowEdgeScaleProblem)
   bool overlays = false;
   bool ply = false;
   int hull_missing_views = 0;  // voxel hull: cameras allowed to disagree (0: the thesis's hull; 1)
