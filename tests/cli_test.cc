@@ -295,6 +295,17 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
   ASSERT_EQ(scaled.exit_code, 0) << scaled.err;
   EXPECT_EQ(nlohmann::json::parse(ReadText(dir / "scaled" / "track.json"))["shadow_edge_scale"], 2.0);
   EXPECT_EQ(nlohmann::json::parse(ReadText(track / "track.json"))["shadow_edge_scale"], 1.0);
+  // Every tracker setting of the binding table (track_settings.h) has its
+  // flag and lands in track.json: here one declared only there.
+  const Result refined = RunIrbench({"track", (dir / "seq").string(), "--stage", "features", "--refine-fraction",
+                                     "0.5", "--out", (dir / "refined").string()},
+                                    dir);
+  ASSERT_EQ(refined.exit_code, 0) << refined.err;
+  const auto refined_meta = nlohmann::json::parse(ReadText(dir / "refined" / "track.json"));
+  EXPECT_EQ(refined_meta["refine_fraction"], 0.5);
+  EXPECT_EQ(refined_meta["particles"], 100);
+  EXPECT_EQ(refined_meta["stage"], "features");
+  EXPECT_EQ(nlohmann::json::parse(ReadText(track / "track.json"))["refine_fraction"], 0.2);
   // ... and reaches shadow removal: on the thesis preset doubled thresholds
   // lose body edges, so some silhouette changes.
   int changed = 0;
@@ -338,6 +349,9 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
          "--background-model"},
         {{"track", (dir / "seq").string(), "--shadow-edge-scale", "0", "--out", (dir / "t6").string()},
          "--shadow-edge-scale"},
+        {{"track", (dir / "seq").string(), "--refine-fraction", "2", "--out", (dir / "t7").string()},
+         "--refine-fraction: '2': must be in 0..1"},
+        {{"track", (dir / "seq").string(), "--seed", "-1", "--out", (dir / "t8").string()}, "--seed"},
         {{"track", (dir / "missing").string()}, "no such sequence folder"},
         {{"track", (dir / "nobg").string()}, "no empty-stage frames"}}) {
     const Result bad = RunIrbench(args, dir);
@@ -345,7 +359,7 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
-  for (const char* name : {"t2", "t3", "t4", "t5", "t6"}) EXPECT_FALSE(fs::exists(dir / name));
+  for (const char* name : {"t2", "t3", "t4", "t5", "t6", "t7", "t8"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
   // An output that would replace the sequence or land in what it reads.
   for (const auto& [out, expected] : {std::pair<fs::path, std::string>{dir / "seq", "would replace the sequence"},
@@ -500,6 +514,13 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   EXPECT_EQ(scale.exit_code, 2) << scale.err;
   EXPECT_NE(scale.err.find("scale.json: scenarios[0].track.shadow_edge_scale: must be in 0.25..8"), std::string::npos)
       << scale.err;
+  // A setting declared once in the tracker's binding table is a suite key too.
+  WriteText(dir / "refine.json", R"({"format": "irbench.suite/1", "name": "t", "scenarios": [
+    {"name": "a", "track": {"refine_fraction": 1.5}}]})");
+  const Result refine = RunIrbench({"suite", "run", (dir / "refine.json").string(), "--cache", (dir / "cache").string()}, dir);
+  EXPECT_EQ(refine.exit_code, 2) << refine.err;
+  EXPECT_NE(refine.err.find("refine.json: scenarios[0].track.refine_fraction: must be in 0..1"), std::string::npos)
+      << refine.err;
 }
 
 TEST(CliTest, MotionExportWritesBvh) {

@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/error.h"
 #include "ci/score/silhouette_score.h"
 #include "sim/sequence/render_job.h"
 #include "tests/test_util.h"
@@ -95,7 +96,7 @@ TEST(FrontendClosedLoopTest, SilhouettesOnTheThesisPreset) {
       const int cam = static_cast<int>(c);
       const std::vector<cv::Mat> background = in.Backgrounds(cam);
       BackgroundOptions plain_options;
-      plain_options.model = "plain";
+      plain_options.model = BackgroundKind::kPlain;
       const auto flicker = BackgroundModel::Train(background, {});
       const auto plain = BackgroundModel::Train(background, plain_options);
       const auto shadows = ShadowRemover::Train(background, {});
@@ -436,7 +437,7 @@ TEST(FrontendClosedLoopTest, PlacementWithoutTheViewThatLostTheLegs) {
   EXPECT_FALSE(PlaceBodyWithoutOneView(carver, empty, FrontEndOptions().placement_max_coverage));
   FrontEndOptions bad;
   bad.placement_max_coverage = 0;
-  EXPECT_THROW(bad.Check(), std::invalid_argument);
+  EXPECT_THROW(bad.Check(), InputError);
   fs::remove_all(dir);
 }
 

@@ -13,9 +13,10 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "sequence_format/manifest.h"
 #include "tracker/io/sequence_input.h"
-#include "tracker/model/body_model.h"
-#include "tracker/model/ellipse_projection.h"
+#include "tracker/body_model/body_model.h"
+#include "tracker/body_model/ellipse_projection.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -147,23 +148,23 @@ std::string Tables(const Score& score) {
 
 // The manifest's names of what was rendered, for the page's heading.
 std::string Describe(const fs::path& sequence) {
-  std::ifstream in(sequence / "manifest.json");
-  const Json m = in ? Json::parse(in, nullptr, false) : Json();
-  if (!m.is_object()) return "";
-  const auto name = [&](const char* key) -> std::string {
-    if (!m.contains(key)) return "";
-    const Json& v = m[key];
-    if (v.is_string()) return v.get<std::string>();
-    if (v.is_object() && v.contains("name") && v["name"].is_string()) return v["name"].get<std::string>();
-    if (v.is_object() && v.contains("preset") && v["preset"].is_string()) return v["preset"].get<std::string>();
-    return "";
-  };
+  Manifest m;
+  try {
+    m = ReadManifest(sequence);
+  } catch (const InputError&) {
+    return "";  // the heading goes without (another tool's folder)
+  }
   std::ostringstream out;
-  for (const char* key : {"scene", "rig", "avatar", "motion", "sensor"}) {
-    const std::string v = name(key);
+  for (const auto& [key, v] : {std::pair<const char*, const std::string&>{"scene", m.scene},
+                               {"rig", m.rig},
+                               {"avatar", m.avatar},
+                               {"motion", m.motion},
+                               {"sensor", m.sensor}}) {
     if (!v.empty()) out << "<span><b>" << key << "</b> " << Escape(v) << "</span> ";
   }
-  if (m.contains("seed") && m["seed"].is_number()) out << "<span><b>seed</b> " << m["seed"].dump() << "</span> ";
+  if (m.json.contains("seed") && m.json["seed"].is_number()) {
+    out << "<span><b>seed</b> " << m.json["seed"].dump() << "</span> ";
+  }
   return out.str();
 }
 

@@ -25,8 +25,8 @@
 #include "tests/render_session.h"
 #include "tests/test_util.h"
 #include "tracker/io/sequence_input.h"
-#include "tracker/model/body_model.h"
-#include "tracker/model/ellipse_projection.h"
+#include "tracker/body_model/body_model.h"
+#include "tracker/body_model/ellipse_projection.h"
 
 namespace irbench {
 namespace {

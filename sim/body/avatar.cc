@@ -1,4 +1,5 @@
 #include "sim/body/avatar.h"
+#include "common/error.h"
 #include "sim/scene/materials.h"
 
 #include <cctype>

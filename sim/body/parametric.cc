@@ -126,12 +126,25 @@ class BodyBuilder {
     primitives_.push_back({std::move(sdf), segment, region, torso, lo, hi});
   }
 
+  // The body's primitives: torso, neck and head, then each side's arm and leg.
   void Primitives(const Avatar& avatar) {
-    const double h = p_.height_m, g = p_.build;
-    const auto& b = avatar.skeleton.bind_position;
+    const double h = p_.height_m;
     const bool loose = s_.clothing == "loose_shirt", jacket = s_.clothing == "jacket";
     // How much clothing stands off the body on the clothed parts.
     const double cloth = jacket ? 0.014 * h : loose ? 0.010 * h : 0.0;
+    TorsoPrimitives(avatar, cloth);
+    HeadPrimitives(avatar);
+    for (int side : {+1, -1}) {
+      ArmPrimitives(avatar, side, cloth, jacket, loose);
+      LegPrimitives(avatar, side, jacket);
+    }
+    blend_ = 0.012 * h;
+  }
+
+  // Torso segments and primitives: the lofted torso, buttocks and belly.
+  void TorsoPrimitives(const Avatar& avatar, double cloth) {
+    const double h = p_.height_m, g = p_.build;
+    const auto& b = avatar.skeleton.bind_position;
     const Region top = Region::kShirt;
     // Torso segments (weights by height along the spine).
     const int seg_pelvis = AddSegment({kPelvis, -1, kSpine, b[kPelvis], b[kSpine], 0, 0.035 * h});
@@ -184,6 +197,12 @@ class BodyBuilder {
       Add([=](const Vec3& p) { return EllipsoidSdf(p, c, r) - cloth; }, seg_pelvis, top, c - r * 1.5,
           c + r * 1.5, true);
     }
+  }
+
+  // Neck, skull and jaw, with the neck and head segments.
+  void HeadPrimitives(const Avatar& avatar) {
+    const double h = p_.height_m, g = p_.build;
+    const auto& b = avatar.skeleton.bind_position;
     // Neck, skull and jaw.
     const int seg_neck = AddSegment({kNeck, kChest, kHead, b[kNeck], b[kHead], 0.015 * h, 0.015 * h});
     const int seg_head = AddSegment({kHead, kNeck, -1, b[kHead], Vec3(0, 0, h), 0.015 * h, 0});
@@ -200,101 +219,113 @@ class BodyBuilder {
       Add([=](const Vec3& p) { return EllipsoidSdf(p, jc, jr); }, seg_head, Region::kSkin, jc - jr * 1.5,
           jc + jr * 1.5);
     }
-    for (int side : {+1, -1}) {
-      const int clav = side > 0 ? kRightClavicle : kLeftClavicle;
-      const int sh = clav + 1, el = clav + 2, wr = clav + 3;
-      const Vec3 x(side, 0, 0);
-      const int seg_clav = AddSegment({clav, kChest, sh, b[clav], b[sh], 0.02 * h, 0.025 * h});
-      const int seg_upper = AddSegment({sh, clav, el, b[sh], b[el], 0.025 * h, 0.022 * h});
-      const int seg_fore = AddSegment({el, sh, wr, b[el], b[wr], 0.022 * h, 0.012 * h});
-      const int seg_hand = AddSegment({wr, el, -1, b[wr], b[wr] + x * hand_length_, 0.012 * h, 0});
-      const double sleeve = jacket ? cloth : loose ? cloth : 0.0;
-      const Region arm_region = s_.clothing == "tight" ? Region::kShirt : top;
-      // Trapezius and shoulder girdle.
-      {
-        const Vec3 a = b[clav] + Vec3(0, -0.004 * h, 0.004 * h), c = b[sh] + Vec3(0, -0.004 * h, 0.006 * h);
-        const double r0 = 0.038 * h * g, r1 = 0.036 * h * g;
-        Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - cloth; }, seg_clav, top,
-            a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
-        // Deltoid.
-        const Vec3 dc = b[sh] + Vec3(side * 0.012 * h, 0, 0.002 * h);
-        const Vec3 dr = Vec3(0.050, 0.040, 0.038) * h * g;
-        Add([=](const Vec3& p) { return EllipsoidSdf(p, dc, dr) - sleeve; }, seg_upper, arm_region,
-            dc - dr * 1.5, dc + dr * 1.5);
-      }
-      // Upper arm with a biceps bulge, forearm with its muscle near the elbow.
-      {
-        const Vec3 a = b[sh], c = b[el];
-        const double r0 = 0.031 * h * g, r1 = 0.022 * h * g;
-        Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - sleeve; }, seg_upper, arm_region,
-            a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
-        const Vec3 bc = a + 0.45 * (c - a) + Vec3(0, 0.008 * h, 0), br = Vec3(0.060, 0.028, 0.026) * h * g;
-        Add([=](const Vec3& p) { return EllipsoidSdf(p, bc, br) - sleeve; }, seg_upper, arm_region,
-            bc - br * 1.5, bc + br * 1.5);
-      }
-      {
-        const Vec3 a = b[el], c = b[wr];
-        const double r0 = 0.022 * h * std::sqrt(g), r1 = 0.0145 * h;
-        const double fs = jacket ? cloth : 0.0;
-        const Region fore_region = jacket ? top : Region::kSkin;
-        Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - fs; }, seg_fore, fore_region,
-            a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
-        const Vec3 mc = a + 0.25 * (c - a), mr = Vec3(0.055, 0.024, 0.025) * h * std::sqrt(g);
-        Add([=](const Vec3& p) { return EllipsoidSdf(p, mc, mr) - fs; }, seg_fore, fore_region, mc - mr * 1.5,
-            mc + mr * 1.5);
-      }
-      // Hand, palm down: palm, fingers to the tip, and a thumb pointing forward.
-      {
-        const double L = hand_length_;
-        const Vec3 palm_c = b[wr] + x * (0.28 * L), palm_h(0.24 * L, 0.022 * h, 0.0085 * h);
-        const Vec3 fing_c = b[wr] + x * (0.745 * L) + Vec3(0, 0, -0.001 * h);
-        const Vec3 fing_h(0.255 * L, 0.020 * h, 0.0060 * h);
-        const Vec3 t0 = b[wr] + x * (0.18 * L) + Vec3(0, 0.016 * h, -0.003 * h);
-        const Vec3 t1 = b[wr] + x * (0.55 * L) + Vec3(0, 0.042 * h, -0.004 * h);
-        const double tr = 0.0062 * h;
-        Add([=](const Vec3& p) {
-              const double palm = RoundedBoxSdf(p, palm_c, palm_h, 0.007 * h);
-              const double fingers = RoundedBoxSdf(p, fing_c, fing_h, 0.0055 * h);
-              const double thumb = ConeCapsuleSdf(p, t0, t1, tr * 1.2, tr);
-              return std::min({palm, fingers, thumb});
-            },
-            seg_hand, Region::kSkin, b[wr].cwiseMin(b[wr] + x * L) - Vec3::Constant(0.06 * h),
-            b[wr].cwiseMax(b[wr] + x * L) + Vec3::Constant(0.06 * h));
-      }
-      // Legs.
-      const int hip = side > 0 ? kRightHip : kLeftHip;
-      const int kn = hip + 1, an = hip + 2;
-      const int seg_thigh = AddSegment({hip, kPelvis, kn, b[hip], b[kn], 0.03 * h, 0.025 * h});
-      const int seg_shin = AddSegment({kn, hip, an, b[kn], b[an], 0.025 * h, 0.015 * h});
-      const int seg_foot = AddSegment({an, kn, -1, b[an], b[an] + Vec3(0, 0.13 * h, -b[an].z()), 0.0, 0});
-      const double trousers = jacket ? 0.004 * h : 0.002 * h;
-      {
-        const Vec3 a = b[hip] + Vec3(side * 0.004 * h, 0, 0.015 * h), c = b[kn];
-        const double r0 = 0.055 * h * g, r1 = 0.033 * h * g;
-        Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - trousers; }, seg_thigh,
-            Region::kPants, a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
-      }
-      {
-        const Vec3 a = b[kn], c = b[an];
-        const double r0 = 0.033 * h * g, r1 = 0.020 * h;
-        Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - trousers; }, seg_shin, Region::kPants,
-            a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
-        const Vec3 cc = a + 0.3 * (c - a) + Vec3(0, -0.012 * h, 0), cr = Vec3(0.030, 0.033, 0.075) * h * g;
-        Add([=](const Vec3& p) { return EllipsoidSdf(p, cc, cr) - trousers; }, seg_shin, Region::kPants,
-            cc - cr * 1.5, cc + cr * 1.5);
-      }
-      {
-        // Foot: a rounded box from the heel to the toes, its sole on the floor.
-        const Vec3 fc(b[an].x(), 0.045 * h, 0.024 * h), fh(0.026 * h, 0.083 * h, 0.024 * h);
-        const Vec3 ac = b[an];
-        const double ar = 0.021 * h;
-        Add([=](const Vec3& p) {
-              return std::min(RoundedBoxSdf(p, fc, fh, 0.012 * h), ConeCapsuleSdf(p, ac, ac + Vec3(0, 0.01 * h, -0.01 * h), ar, ar));
-            },
-            seg_foot, Region::kShoes, fc - fh - Vec3::Constant(0.05 * h), fc + fh + Vec3::Constant(0.05 * h));
-      }
+  }
+
+  // One side's (+1 right, -1 left) arm segments and primitives: shoulder
+  // girdle, upper arm, forearm and hand.
+  void ArmPrimitives(const Avatar& avatar, int side, double cloth, bool jacket, bool loose) {
+    const double h = p_.height_m, g = p_.build;
+    const auto& b = avatar.skeleton.bind_position;
+    const Region top = Region::kShirt;
+    const int clav = side > 0 ? kRightClavicle : kLeftClavicle;
+    const int sh = clav + 1, el = clav + 2, wr = clav + 3;
+    const Vec3 x(side, 0, 0);
+    const int seg_clav = AddSegment({clav, kChest, sh, b[clav], b[sh], 0.02 * h, 0.025 * h});
+    const int seg_upper = AddSegment({sh, clav, el, b[sh], b[el], 0.025 * h, 0.022 * h});
+    const int seg_fore = AddSegment({el, sh, wr, b[el], b[wr], 0.022 * h, 0.012 * h});
+    const int seg_hand = AddSegment({wr, el, -1, b[wr], b[wr] + x * hand_length_, 0.012 * h, 0});
+    const double sleeve = jacket ? cloth : loose ? cloth : 0.0;
+    const Region arm_region = s_.clothing == "tight" ? Region::kShirt : top;
+    // Trapezius and shoulder girdle.
+    {
+      const Vec3 a = b[clav] + Vec3(0, -0.004 * h, 0.004 * h), c = b[sh] + Vec3(0, -0.004 * h, 0.006 * h);
+      const double r0 = 0.038 * h * g, r1 = 0.036 * h * g;
+      Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - cloth; }, seg_clav, top,
+          a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
+      // Deltoid.
+      const Vec3 dc = b[sh] + Vec3(side * 0.012 * h, 0, 0.002 * h);
+      const Vec3 dr = Vec3(0.050, 0.040, 0.038) * h * g;
+      Add([=](const Vec3& p) { return EllipsoidSdf(p, dc, dr) - sleeve; }, seg_upper, arm_region,
+          dc - dr * 1.5, dc + dr * 1.5);
     }
-    blend_ = 0.012 * h;
+    // Upper arm with a biceps bulge, forearm with its muscle near the elbow.
+    {
+      const Vec3 a = b[sh], c = b[el];
+      const double r0 = 0.031 * h * g, r1 = 0.022 * h * g;
+      Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - sleeve; }, seg_upper, arm_region,
+          a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
+      const Vec3 bc = a + 0.45 * (c - a) + Vec3(0, 0.008 * h, 0), br = Vec3(0.060, 0.028, 0.026) * h * g;
+      Add([=](const Vec3& p) { return EllipsoidSdf(p, bc, br) - sleeve; }, seg_upper, arm_region,
+          bc - br * 1.5, bc + br * 1.5);
+    }
+    {
+      const Vec3 a = b[el], c = b[wr];
+      const double r0 = 0.022 * h * std::sqrt(g), r1 = 0.0145 * h;
+      const double fs = jacket ? cloth : 0.0;
+      const Region fore_region = jacket ? top : Region::kSkin;
+      Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - fs; }, seg_fore, fore_region,
+          a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
+      const Vec3 mc = a + 0.25 * (c - a), mr = Vec3(0.055, 0.024, 0.025) * h * std::sqrt(g);
+      Add([=](const Vec3& p) { return EllipsoidSdf(p, mc, mr) - fs; }, seg_fore, fore_region, mc - mr * 1.5,
+          mc + mr * 1.5);
+    }
+    // Hand, palm down: palm, fingers to the tip, and a thumb pointing forward.
+    {
+      const double L = hand_length_;
+      const Vec3 palm_c = b[wr] + x * (0.28 * L), palm_h(0.24 * L, 0.022 * h, 0.0085 * h);
+      const Vec3 fing_c = b[wr] + x * (0.745 * L) + Vec3(0, 0, -0.001 * h);
+      const Vec3 fing_h(0.255 * L, 0.020 * h, 0.0060 * h);
+      const Vec3 t0 = b[wr] + x * (0.18 * L) + Vec3(0, 0.016 * h, -0.003 * h);
+      const Vec3 t1 = b[wr] + x * (0.55 * L) + Vec3(0, 0.042 * h, -0.004 * h);
+      const double tr = 0.0062 * h;
+      Add([=](const Vec3& p) {
+            const double palm = RoundedBoxSdf(p, palm_c, palm_h, 0.007 * h);
+            const double fingers = RoundedBoxSdf(p, fing_c, fing_h, 0.0055 * h);
+            const double thumb = ConeCapsuleSdf(p, t0, t1, tr * 1.2, tr);
+            return std::min({palm, fingers, thumb});
+          },
+          seg_hand, Region::kSkin, b[wr].cwiseMin(b[wr] + x * L) - Vec3::Constant(0.06 * h),
+          b[wr].cwiseMax(b[wr] + x * L) + Vec3::Constant(0.06 * h));
+    }
+  }
+
+  // One side's (+1 right, -1 left) leg segments and primitives: thigh, shin
+  // and foot.
+  void LegPrimitives(const Avatar& avatar, int side, bool jacket) {
+    const double h = p_.height_m, g = p_.build;
+    const auto& b = avatar.skeleton.bind_position;
+    // Legs.
+    const int hip = side > 0 ? kRightHip : kLeftHip;
+    const int kn = hip + 1, an = hip + 2;
+    const int seg_thigh = AddSegment({hip, kPelvis, kn, b[hip], b[kn], 0.03 * h, 0.025 * h});
+    const int seg_shin = AddSegment({kn, hip, an, b[kn], b[an], 0.025 * h, 0.015 * h});
+    const int seg_foot = AddSegment({an, kn, -1, b[an], b[an] + Vec3(0, 0.13 * h, -b[an].z()), 0.0, 0});
+    const double trousers = jacket ? 0.004 * h : 0.002 * h;
+    {
+      const Vec3 a = b[hip] + Vec3(side * 0.004 * h, 0, 0.015 * h), c = b[kn];
+      const double r0 = 0.055 * h * g, r1 = 0.033 * h * g;
+      Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - trousers; }, seg_thigh,
+          Region::kPants, a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
+    }
+    {
+      const Vec3 a = b[kn], c = b[an];
+      const double r0 = 0.033 * h * g, r1 = 0.020 * h;
+      Add([=](const Vec3& p) { return ConeCapsuleSdf(p, a, c, r0, r1) - trousers; }, seg_shin, Region::kPants,
+          a.cwiseMin(c) - Vec3::Constant(2 * r0), a.cwiseMax(c) + Vec3::Constant(2 * r0));
+      const Vec3 cc = a + 0.3 * (c - a) + Vec3(0, -0.012 * h, 0), cr = Vec3(0.030, 0.033, 0.075) * h * g;
+      Add([=](const Vec3& p) { return EllipsoidSdf(p, cc, cr) - trousers; }, seg_shin, Region::kPants,
+          cc - cr * 1.5, cc + cr * 1.5);
+    }
+    {
+      // Foot: a rounded box from the heel to the toes, its sole on the floor.
+      const Vec3 fc(b[an].x(), 0.045 * h, 0.024 * h), fh(0.026 * h, 0.083 * h, 0.024 * h);
+      const Vec3 ac = b[an];
+      const double ar = 0.021 * h;
+      Add([=](const Vec3& p) {
+            return std::min(RoundedBoxSdf(p, fc, fh, 0.012 * h), ConeCapsuleSdf(p, ac, ac + Vec3(0, 0.01 * h, -0.01 * h), ar, ar));
+          },
+          seg_foot, Region::kShoes, fc - fh - Vec3::Constant(0.05 * h), fc + fh + Vec3::Constant(0.05 * h));
+    }
   }
 
   // The body's signed distance and the primitive that owns the point.

@@ -14,8 +14,7 @@ std::string CheckDistortionUsable(const Camera& camera) {
   double max_r2 = 0;
   for (double u : {-0.5, w - 0.5}) {
     for (double v : {-0.5, h - 0.5}) {
-      const double xd = (u - camera.cx) / camera.fx, yd = (v - camera.cy) / camera.fy;
-      const auto xu = camera.Undistort({xd, yd});
+      const auto xu = camera.UndistortPixel({u, v});
       if (!xu) return "distortion does not invert at the image corner";
       max_r2 = std::max(max_r2, xu->squaredNorm());
     }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 
 namespace irbench {
 

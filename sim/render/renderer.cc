@@ -294,9 +294,10 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
     // Extent of the undistorted image of the output border, in output pixels.
     double u_min = 1e9, u_max = -1e9, v_min = 1e9, v_max = -1e9;
     auto extend = [&](double u, double v) {
-      const auto x_u = cam.Undistort({(u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy});
+      const auto x_u = cam.UndistortPixel({u, v});
       if (!x_u) throw InputError("", "cameras." + cam.name + ".dist", "distortion does not invert");
-      const double pu = cam.fx * x_u->x() + cam.cx, pv = cam.fy * x_u->y() + cam.cy;
+      const Eigen::Vector2d px_undistorted = cam.NormalisedToPixel(*x_u);
+      const double pu = px_undistorted.x(), pv = px_undistorted.y();
       u_min = std::min(u_min, pu), u_max = std::max(u_max, pu);
       v_min = std::min(v_min, pv), v_max = std::max(v_max, pv);
     };
@@ -327,9 +328,10 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
     target->map_y.create(cam.height, cam.width, CV_32FC1);
     for (int v = 0; v < cam.height; ++v) {
       for (int u = 0; u < cam.width; ++u) {
-        const auto x_u = cam.Undistort({(u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy});
-        target->map_x.at<float>(v, u) = static_cast<float>(rc.fx * x_u->x() + rc.cx);
-        target->map_y.at<float>(v, u) = static_cast<float>(rc.fy * x_u->y() + rc.cy);
+        const auto x_u = cam.UndistortPixel(Eigen::Vector2d(u, v));
+        const Eigen::Vector2d px_render = rc.NormalisedToPixel(*x_u);
+        target->map_x.at<float>(v, u) = static_cast<float>(px_render.x());
+        target->map_y.at<float>(v, u) = static_cast<float>(px_render.y());
       }
     }
     target->clip_from_world = ClipFromCam(rc, options_.near_m, options_.far_m) *

@@ -10,7 +10,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 #include "sim/gl/gl_context.h"
 #include "sim/lighting/bounce.h"
 #include "sim/scene/mesh.h"

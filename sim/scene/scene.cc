@@ -5,6 +5,7 @@
 #include <set>
 
 #include "common/json_reader.h"
+#include "sequence_format/screens.h"
 #include "sim/scene/materials.h"
 
 namespace irbench {
@@ -19,78 +20,21 @@ void CheckBox(const JsonNode& node, const Eigen::Vector3d& min, const Eigen::Vec
   if ((max - min).minCoeff() <= 0) node["max"].Fail("must exceed 'min' on every axis");
 }
 
-ScreenSurface ReadScreen(const JsonNode& s) {
-  ScreenSurface screen;
-  screen.name = s.GetString("name");
-  const std::string type = s.GetString("type");
-  if (type == "cylinder") {
-    s.CheckKeys({"name", "type", "center_xy", "radius", "angle_left_deg", "angle_right_deg", "z",
-                 "albedo", "content_radiance", "targets", "description"});
-    screen.kind = ScreenSurface::Kind::kCylinder;
-    screen.center_xy = s["center_xy"].Vec2();
-    screen.radius = s.GetDouble("radius");
-    if (screen.radius <= 0) s["radius"].Fail("must be positive");
-    screen.angle_left_deg = s.GetDouble("angle_left_deg");
-    screen.angle_right_deg = s.GetDouble("angle_right_deg");
-    if (screen.angle_left_deg <= screen.angle_right_deg ||
-        screen.angle_left_deg - screen.angle_right_deg > 360) {
-      s["angle_left_deg"].Fail("must exceed angle_right_deg by at most 360");
-    }
-    const Eigen::Vector2d z = s["z"].Vec2();
-    screen.z0 = z.x();
-    screen.z1 = z.y();
-    if (screen.z1 <= screen.z0) s["z"].Fail("top must be above bottom");
-  } else if (type == "plane") {
-    s.CheckKeys({"name", "type", "origin", "right", "up", "width", "height", "albedo", "content_radiance",
-                 "targets", "description"});
-    screen.kind = ScreenSurface::Kind::kPlane;
-    screen.origin = s.GetVec3("origin");
-    screen.right = s.GetVec3("right");
-    screen.up = s.GetVec3("up");
-    if (screen.right.norm() < 1e-9) s["right"].Fail("must be non-zero");
-    if (screen.up.norm() < 1e-9) s["up"].Fail("must be non-zero");
-    screen.right.normalize();
-    screen.up.normalize();
-    if (std::abs(screen.right.dot(screen.up)) > 1e-6) s["up"].Fail("must be perpendicular to 'right'");
-    screen.width = s.GetDouble("width");
-    screen.height = s.GetDouble("height");
-    if (screen.width <= 0) s["width"].Fail("must be positive");
-    if (screen.height <= 0) s["height"].Fail("must be positive");
-  } else {
-    s["type"].Fail("unknown screen type '" + type + "' (cylinder, plane)");
-  }
-  screen.material = ReadMaterial(s, "albedo", 0.8f);
+// A scene file's screen: its surface (sequence_format/screens.h, shared with
+// calib/screens.json) and how it renders.
+ScreenSurface ReadScreen(const JsonNode& s, Material* material) {
+  ScreenSurface screen = ReadScreenSurface(s, {"albedo", "content_radiance", "description"});
+  *material = ReadMaterial(s, "albedo", 0.8f);
   // The near-IR radiance the projected content adds (projectors leak near IR);
   // it flickers with the content (docs/sensor.md).
-  screen.material.content = static_cast<float>(s.GetDouble("content_radiance", 0.0));
-  if (screen.material.content < 0 || screen.material.content > 10) {
+  material->content = static_cast<float>(s.GetDouble("content_radiance", 0.0));
+  if (material->content < 0 || material->content > 10) {
     s["content_radiance"].Fail("must be in [0, 10]");
-  }
-  if (s.Has("targets")) {
-    const JsonNode targets = s["targets"];
-    const Eigen::Vector2d size = screen.Size();
-    for (const std::string& name : targets.Keys()) {
-      const Eigen::Vector2d st = targets[name].Vec2();
-      if (st.x() < 0 || st.x() > size.x() || st.y() < 0 || st.y() > size.y()) {
-        targets[name].Fail("target outside the screen (size " + std::to_string(size.x()) + " x " +
-                           std::to_string(size.y()) + " m)");
-      }
-      screen.targets[name] = st;
-    }
   }
   return screen;
 }
 
 }  // namespace
-
-nlohmann::json Scene::ScreensJson() const {
-  nlohmann::json j;
-  j["format"] = "irbench.screens/1";
-  j["scene"] = name;
-  j["screens"] = nlohmann::json::array();
-  for (const ScreenSurface& s : screens) j["screens"].push_back(s.ToJson());
-  return j;
-}
 
 Scene LoadScene(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
@@ -156,9 +100,10 @@ Scene LoadScene(const std::filesystem::path& path) {
     const JsonNode screens = root["screens"];
     std::set<std::string> names;
     for (size_t i = 0; i < screens.Size(); ++i) {
-      ScreenSurface screen = ReadScreen(screens[i]);
+      Material material;
+      ScreenSurface screen = ReadScreen(screens[i], &material);
       if (!names.insert(screen.name).second) screens[i]["name"].Fail("duplicate screen name");
-      screen.AppendGeometry(scene.mesh);
+      AppendScreenGeometry(screen, material, scene.mesh);
       scene.screens.push_back(std::move(screen));
     }
   }

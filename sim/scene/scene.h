@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "sim/scene/mesh.h"
-#include "sim/scene/screen.h"
+#include "sim/scene/screen_mesh.h"
 
 namespace irbench {
 
@@ -45,9 +45,6 @@ struct Scene {
   std::vector<ScreenSurface> screens;
   std::vector<IrLight> lights;
   TriangleMesh mesh;  // all static geometry, screens included
-
-  // calib/screens.json content.
-  nlohmann::json ScreensJson() const;
 };
 
 Scene LoadScene(const std::filesystem::path& path);

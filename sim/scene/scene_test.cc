@@ -51,40 +51,6 @@ TEST(SceneTest, RaysToTargetsHitTheirScreenCoordinates) {
   }
 }
 
-TEST(SceneTest, CylinderScreenCoordinatesAreArcLengthFromTheLeftEdge) {
-  ScreenSurface screen;
-  screen.kind = ScreenSurface::Kind::kCylinder;
-  screen.radius = 4.0;
-  screen.angle_left_deg = 150;
-  screen.angle_right_deg = 30;
-  screen.z0 = 1.0;
-  screen.z1 = 3.0;
-  EXPECT_NEAR(screen.Size().x(), 4.0 * 120 * M_PI / 180, 1e-12);
-  // The middle of the arc is straight ahead (+y) of the centre.
-  const Eigen::Vector3d mid = screen.PointAt({screen.Size().x() / 2, 0.5});
-  EXPECT_NEAR(mid.x(), 0, 1e-12);
-  EXPECT_NEAR(mid.y(), 4.0, 1e-12);
-  EXPECT_NEAR(mid.z(), 1.5, 1e-12);
-  // s grows towards the viewer's right (+x when facing +y).
-  EXPECT_LT(screen.PointAt({1.0, 0}).x(), screen.PointAt({2.0, 0}).x());
-  // Looking backwards misses.
-  EXPECT_FALSE(screen.Intersect({0, 0, 1.5}, {0, -1, 0}).has_value());
-}
-
-TEST(SceneTest, PlaneScreenIsHitOnlyFromTheFront) {
-  ScreenSurface screen;
-  screen.origin = {-1, 3, 0.5};
-  screen.right = {1, 0, 0};
-  screen.up = {0, 0, 1};
-  screen.width = 2;
-  screen.height = 1.5;
-  const auto hit = screen.Intersect({0, 0, 1}, {0, 1, 0});
-  ASSERT_TRUE(hit.has_value());
-  EXPECT_NEAR(hit->x(), 1.0, 1e-12);
-  EXPECT_NEAR(hit->y(), 0.5, 1e-12);
-  EXPECT_FALSE(screen.Intersect({0, 5, 1}, {0, -1, 0}).has_value());
-}
-
 }  // namespace
 }  // namespace irbench
 

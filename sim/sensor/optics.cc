@@ -11,7 +11,7 @@ Optics::Optics(const OpticsParams& params, const Camera& camera) : params_(param
     vignette_.create(camera.height, camera.width, CV_32FC1);
     for (int v = 0; v < camera.height; ++v) {
       for (int u = 0; u < camera.width; ++u) {
-        const auto x = camera.Undistort({(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy});
+        const auto x = camera.UndistortPixel(Eigen::Vector2d(u, v));
         const double cos2 = x ? 1.0 / (1.0 + x->squaredNorm()) : 1.0;
         vignette_.at<float>(v, u) =
             static_cast<float>(1.0 - params.vignetting * (1.0 - cos2 * cos2));

@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 
 namespace irbench {
 

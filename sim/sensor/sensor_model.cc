@@ -175,6 +175,14 @@ nlohmann::json FlickerParams::ToJson() const { return KnobsToJson(*this); }
 nlohmann::json OpticsToJson(const OpticsParams& optics) { return KnobsToJson(optics); }
 nlohmann::json CaptureToJson(const CaptureParams& capture) { return KnobsToJson(capture); }
 
+nlohmann::json SensorSetupJson(const SensorSetup& setup) {
+  return {{"preset", setup.preset},
+          {"emva1288", setup.sensor.ToJson()},
+          {"flicker", setup.flicker.ToJson()},
+          {"optics", OpticsToJson(setup.optics)},
+          {"capture", CaptureToJson(setup.capture)}};
+}
+
 std::optional<SensorSetup> SensorPreset(const std::string& name) {
   SensorSetup s;
   s.preset = name;
@@ -191,6 +199,7 @@ std::optional<SensorSetup> SensorPreset(const std::string& name) {
     s.sensor.full_well_e = 1e7;
     return s;
   }
+  s.models_sensor = true;
   if (name == "thesis") {
     // Thesis 1.2: very dark, illumination that changes with the screen's
     // content, washed out with a limited grey range, grainy.

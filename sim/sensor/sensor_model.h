@@ -71,6 +71,10 @@ struct CaptureParams {
 
 struct SensorSetup {
   std::string preset = "clean";
+  // Whether the preset models a sensor at all: false for `clean`, whose
+  // frames are the renderer's grey (no noise, flicker, optics, soft shadows
+  // by default).
+  bool models_sensor = false;
   SensorParams sensor;
   FlickerParams flicker;
   OpticsParams optics;
@@ -79,6 +83,9 @@ struct SensorSetup {
 
 nlohmann::json OpticsToJson(const OpticsParams& optics);
 nlohmann::json CaptureToJson(const CaptureParams& capture);
+// Every knob of a camera's sensor setup, as calib/cameras.json lists it per
+// camera: {preset, emva1288, flicker, optics, capture}.
+nlohmann::json SensorSetupJson(const SensorSetup& setup);
 
 // "clean" (no noise, no flicker, linear), "thesis" (the thesis's 1.2: dark,
 // flickering, washed out, grainy), "harsh". nullopt for unknown names.

@@ -21,7 +21,7 @@ std::vector<RenderBenchResult> RunRenderBench(const RenderJobOptions& options,
     std::vector<Camera> cameras;
     for (const Camera& cam : base_cameras) cameras.push_back(cam.Scaled(scale));
     in.rig.cameras = cameras;
-    Renderer renderer(*context, cameras, RenderOptionsFor(options));
+    Renderer renderer(*context, cameras, RenderOptionsFor(options, in));
     renderer.SetScene(in.scene);
     renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
     std::vector<MeshVertex> skinned;

@@ -1,3 +1,6 @@
+#include "sequence_format/calibration.h"
+#include "sequence_format/manifest.h"
+#include "sequence_format/screens.h"
 #include "sim/sequence/render_job.h"
 
 #include <algorithm>
@@ -10,10 +13,9 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "common/paths.h"
-#include "sim/sequence/calib_io.h"
 #include "sim/sequence/image_io.h"
 #include "sim/motion/bvh.h"
-#include "sim/sensor/flicker.h"
+#include "sim/sensor/exposure.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -57,6 +59,7 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   if (!preset) {
     throw InputError("", "--sensor", "unknown preset '" + options.sensor + "' (clean, thesis, harsh)");
   }
+  in.models_sensor = preset->models_sensor;
   if (options.frames && (*options.frames < 1 || *options.frames > 1000000)) {
     throw InputError("", "--frames", "must be in 1..1000000");
   }
@@ -98,7 +101,7 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
       ApplySensorOverrides(overrides, in.rig_file.string(), "cameras[" + std::to_string(i) + "].sensor",
                            &setup);
     }
-    in.sensor_active.push_back(options.sensor != "clean" || !overrides.is_null());
+    in.sensor_active.push_back(preset->models_sensor || !overrides.is_null());
     in.sensors.push_back(setup);
   }
   in.frame_count = options.frames.value_or(
@@ -106,10 +109,10 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   return in;
 }
 
-RenderOptions RenderOptionsFor(const RenderJobOptions& options) {
+RenderOptions RenderOptionsFor(const RenderJobOptions& options, const RenderInputs& in) {
   RenderOptions render_options;
   render_options.supersample = options.supersample;
-  render_options.shadows = options.shadows.value_or(options.sensor != "clean");
+  render_options.shadows = options.shadows.value_or(in.models_sensor);
   return render_options;
 }
 
@@ -145,17 +148,18 @@ FrameTruth ComputeFrameTruth(const RenderInputs& inputs,
   return truth;
 }
 
-fs::path RunRenderJob(const RenderJobOptions& options) {
-  // 1. Everything from outside is checked before anything is created.
-  const RenderInputs in = LoadRenderInputs(options);
-  const bool sweep_screens = SweepsScreens(options, in);
+namespace {
+
+// The sequence folder to write: --out, or renders/<rig>-<avatar>-<motion>-s<seed>.
+// Throws InputError when its parent folder is missing, or when it exists and
+// --force was not given; checked before the slow GL start.
+fs::path OutputFolder(const RenderJobOptions& options, const RenderInputs& in) {
   fs::path out = options.out;
   if (out.empty()) {
     out = DataRoot() / "renders" /
           (in.rig.name + "-" + in.avatar.params.name + "-" + in.motion_name + "-s" +
            std::to_string(options.seed));
   }
-  // Checks the parent folder and an existing output before the slow GL start.
   if (!fs::is_directory(fs::absolute(out).parent_path())) {
     throw InputError("", "--out", "parent folder '" + fs::absolute(out).parent_path().string() +
                                       "' does not exist");
@@ -163,18 +167,12 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   if (fs::exists(out) && !options.overwrite) {
     throw InputError("", "--out", "'" + out.string() + "' exists (pass --force to replace it)");
   }
+  return out;
+}
 
-  // 2. GL and the renderer.
-  auto context = CreateGlContext(options.backend);
-  Log().info("render: {} backend, {}", context->BackendName(), context->RendererString());
-  const RenderOptions render_options = RenderOptionsFor(options);
-  Renderer renderer(*context, in.rig.cameras, render_options);
-  renderer.SetScene(in.scene);
-  renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
-
-  // 3. The staging folder and the static files.
-  StagingDir staging(out, options.overwrite, "--out");
-  const fs::path root = staging.path();
+// Creates the sequence folder's sub-folders under `root` (per camera:
+// background/, frames/, truth/masks/ and, with `write_depth`, truth/depth/).
+void CreateSequenceFolders(const fs::path& root, const RenderInputs& in, bool write_depth) {
   for (const char* dir : {"calib", "background", "frames", "truth", "truth/masks"}) {
     fs::create_directories(root / dir);
   }
@@ -182,14 +180,27 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     fs::create_directories(root / "background" / cam.name);
     fs::create_directories(root / "frames" / cam.name);
     fs::create_directories(root / "truth" / "masks" / cam.name);
-    if (options.write_depth) fs::create_directories(root / "truth" / "depth" / cam.name);
+    if (write_depth) fs::create_directories(root / "truth" / "depth" / cam.name);
   }
-  AtomicWriteFile(root / "calib" / "intri.yml", IntriYaml(in.rig.cameras));
-  AtomicWriteFile(root / "calib" / "extri.yml", ExtriYaml(in.rig.cameras));
-  AtomicWriteFile(root / "calib" / "cameras.json",
-                  CamerasJson(in.rig.cameras, in.sensors).dump(2) + "\n");
-  AtomicWriteFile(root / "calib" / "screens.json", in.scene.ScreensJson().dump(2) + "\n");
+}
 
+// Writes the rig's calibration (calib/intri.yml, calib/extri.yml,
+// calib/cameras.json with the sensor setups) and the scene's screens
+// (calib/screens.json) under `root`.
+void WriteSequenceCalibration(const fs::path& root, const RenderInputs& in) {
+  std::vector<nlohmann::json> sensors;
+  for (const SensorSetup& sensor : in.sensors) sensors.push_back(SensorSetupJson(sensor));
+  WriteCalibration(root, in.rig.cameras, sensors);
+  WriteScreens(root, in.scene.name, in.scene.screens);
+}
+
+// The sequence's manifest.json (docs/architecture.md): what was rendered,
+// from which inputs, with which renderer, and where its files lie.
+nlohmann::json BuildManifest(const RenderJobOptions& options,
+                             const RenderInputs& in,
+                             bool sweep_screens,
+                             const GlContext& context,
+                             const RenderOptions& render_options) {
   nlohmann::json manifest;
   manifest["format"] = "irbench.sequence/1";
   manifest["tool_version"] = ToolVersion();
@@ -228,8 +239,8 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   manifest["body_height_m"] = in.avatar.params.height_m;
   manifest["joints"] = TruthJointNames();
   manifest["depth"] = options.write_depth;
-  manifest["renderer"] = {{"backend", context->BackendName()},
-                          {"gl", context->RendererString()},
+  manifest["renderer"] = {{"backend", context.BackendName()},
+                          {"gl", context.RendererString()},
                           {"supersample", options.supersample},
                           {"shadows", render_options.shadows}};
   manifest["files"] = {{"frames", "frames/<cam>/NNNNNN.png"},
@@ -240,233 +251,278 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
                        {"events", "truth/events.json"},
                        {"motion_bvh", "truth/motion.bvh"}};
   if (options.write_depth) manifest["files"]["depth"] = "truth/depth/<cam>/NNNNNN.exr";
+  return manifest;
+}
 
-  const auto start = std::chrono::steady_clock::now();
-  auto last_report = start;
-  const int total = options.background_frames + in.frame_count;
-  int done = 0;
-  auto report = [&](const char* phase, int index, int count) {
+// The render's progress in frame-sets, logged at most once a second and at
+// each phase's last frame-set.
+class RenderProgress {
+ public:
+  RenderProgress() : start_(std::chrono::steady_clock::now()), last_report_(start_) {}
+
+  // Counts one frame-set done, then logs frame-set `index` of `count` of
+  // `phase` when due.
+  void FrameSetDone(const char* phase, int index, int count) {
+    ++done_;
     const auto now = std::chrono::steady_clock::now();
-    if (now - last_report < std::chrono::seconds(1) && index + 1 < count) return;
-    last_report = now;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
+    if (now - last_report_ < std::chrono::seconds(1) && index + 1 < count) return;
+    last_report_ = now;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
     Log().info("render: {} {}/{} ({:.1f} frame-sets/s)", phase, index + 1, count,
-               elapsed > 0 ? done / elapsed : 0.0);
-  };
+               elapsed > 0 ? done_ / elapsed : 0.0);
+  }
 
-  // The sensor model per camera; background frames come before t = 0.
-  const double background_s = options.background_frames / in.fps;
-  std::vector<SensorModel> sensors;
-  std::vector<FlickerModel> flickers;
-  std::vector<Optics> optics;
-  int blur_samples = 1;           // sub-frame renders per frame (motion blur)
-  double blur_exposure_s = 0.0;   // the exposure they span
-  bool need_depth = options.write_depth;
+  // Seconds since the progress began.
+  double ElapsedS() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_report_;
+  int done_ = 0;
+};
+
+// Motion blur: sub-frame renders over the exposure, averaged.
+struct MotionBlurPlan {
+  int samples = 1;          // sub-frame renders per frame
+  double exposure_s = 0.0;  // the exposure they span
+  // Sub-frame offsets (s) from the camera's instant, the final render at the
+  // instant itself left out; with an odd count that is the centre one.
+  std::vector<double> offsets;
+  bool centre_counts = false;  // whether the final render is one of the samples
+};
+
+// The motion blur of the cameras with a sensor model: the most sub-frames any
+// asks for, over the longest exposure of those blurring.
+MotionBlurPlan PlanMotionBlur(const RenderInputs& in) {
+  MotionBlurPlan blur;
   for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
     const Camera& cam = in.rig.cameras[c];
     const SensorSetup& setup = in.sensors[c];
-    sensors.emplace_back(setup.sensor, options.seed, cam.name, cam.width, cam.height);
-    flickers.emplace_back(setup.flicker, options.seed, -background_s, in.frame_count / in.fps);
-    optics.emplace_back(setup.optics, cam);
     if (!in.sensor_active[c]) continue;
-    if (setup.optics.motion_blur_samples > blur_samples) blur_samples = setup.optics.motion_blur_samples;
+    if (setup.optics.motion_blur_samples > blur.samples) blur.samples = setup.optics.motion_blur_samples;
     if (setup.optics.motion_blur_samples > 1) {
-      blur_exposure_s = std::max(blur_exposure_s, cam.exposure_ms / 1000.0);
+      blur.exposure_s = std::max(blur.exposure_s, cam.exposure_ms / 1000.0);
     }
-    need_depth = need_depth || setup.optics.f_number > 0;
   }
-  // Turns camera c's render (its radiance per source, or their mean over the
-  // exposure's sub-frames, `radiance_sum` / `samples`) into the written frame:
-  // the illuminators' light follows the mains, the screens' content light the
-  // content's flicker, each row its own with a rolling shutter; the 940 nm
-  // light counts by the sensor's relative quantum efficiency. A `sweep` level
-  // of 0 or more replaces the content's (the calibration sweep of empty-stage
-  // frames). Records the levels, exposure and drops in `sensor_truth`.
-  std::vector<cv::Mat> last_written(in.rig.cameras.size());
-  std::vector<double> last_flicker(in.rig.cameras.size(), 1.0);  // of the image a drop repeats
-  cv::Mat radiance;
-  auto expose = [&](size_t c, const CameraImages& images, const cv::Mat& radiance_sum, int samples,
-                    double t, uint64_t noise_frame, nlohmann::json& sensor_truth, double sweep = -1) -> cv::Mat {
-    const Camera& cam = in.rig.cameras[c];
-    if (!in.sensor_active[c]) {
-      sensor_truth[cam.name] = {{"flicker", 1.0}, {"screen", 1.0}, {"illuminators", 1.0},
-                                {"exposure_ms", cam.exposure_ms}, {"dropped", false}};
-      return images.grey;
-    }
-    const SensorSetup& setup = in.sensors[c];
-    // The exposure is centred on the frame time, where the truth is; with a
-    // rolling shutter, the middle row's is.
-    const double exposure_s = cam.exposure_ms / 1000.0;
-    const double start_s = t - 0.5 * exposure_s;
-    const double mains = flickers[c].MainsMean(start_s, exposure_s);
-    const double screen = sweep >= 0 ? sweep : flickers[c].ScreenMean(start_s, exposure_s);
-    const double drop_u = UniformFromHash(MixHash(options.seed, 0xD50Bull + c), noise_frame);
-    const bool dropped = drop_u < setup.capture.drop_rate && !last_written[c].empty();
-    nlohmann::json& truth = sensor_truth[cam.name];
-    // A dropped frame repeats the last image, and its illumination.
-    truth = {{"flicker", last_flicker[c]}, {"screen", screen}, {"illuminators", mains},
-             {"exposure_ms", cam.exposure_ms}, {"dropped", dropped}};
-    if (dropped) return last_written[c];
-    const cv::Mat sources = samples > 1 ? cv::Mat(radiance_sum / samples) : images.radiance;
-    const double qe = setup.sensor.quantum_efficiency;
-    const float q940 = qe > 0 ? static_cast<float>(setup.sensor.quantum_efficiency_940 / qe) : 0.0f;
-    const float q_content = 0.5f * (1.0f + q940);
-    const double readout_s = setup.capture.rolling_shutter_ms / 1000.0;
-    const cv::Scalar mean = cv::mean(sources);
-    const double steady = mean[0] + q940 * mean[1] + q_content * mean[2] + mean[3];
-    double lit = 0;
-    if (readout_s <= 0 || sources.rows < 2) {
-      const float m = static_cast<float>(mains), s = static_cast<float>(screen);
-      const cv::Matx14f weights(m, m * q940, s * q_content, 1.0f);
-      cv::transform(sources, radiance, weights);
-      lit = mains * (mean[0] + q940 * mean[1]) + screen * q_content * mean[2] + mean[3];
-    } else {
-      radiance.create(sources.size(), CV_32FC1);
-      for (int y = 0; y < sources.rows; ++y) {
-        const double row_start = start_s + (double(y) / (sources.rows - 1) - 0.5) * readout_s;
-        const float m = static_cast<float>(flickers[c].MainsMean(row_start, exposure_s));
-        const float s = static_cast<float>(sweep >= 0 ? sweep : flickers[c].ScreenMean(row_start, exposure_s));
-        const cv::Vec4f* in_row = sources.ptr<cv::Vec4f>(y);
-        float* out_row = radiance.ptr<float>(y);
-        double row_sum = 0;
-        for (int x = 0; x < sources.cols; ++x) {
-          const cv::Vec4f& v = in_row[x];
-          out_row[x] = m * (v[0] + q940 * v[1]) + s * q_content * v[2] + v[3];
-          row_sum += out_row[x];
-        }
-        lit += row_sum / (double(sources.rows) * sources.cols);
-      }
-    }
-    last_flicker[c] = steady > 0 ? lit / steady : 1.0;
-    truth["flicker"] = last_flicker[c];
-    const cv::Mat seen = optics[c].Apply(radiance, images.depth);
-    last_written[c] = sensors[c].ToOutput(sensors[c].Expose(seen, cam.exposure_ms, noise_frame));
-    return last_written[c];
-  };
+  for (int k = 0; blur.samples > 1 && k < blur.samples; ++k) {
+    const double offset = ((k + 0.5) / blur.samples - 0.5) * blur.exposure_s;
+    if (std::abs(offset) > 1e-12) blur.offsets.push_back(offset);
+  }
+  blur.centre_counts = blur.samples > 1 && blur.samples % 2 == 1;
+  return blur;
+}
 
-  // 4. Empty-stage frames.
-  std::vector<CameraImages> all_images;
+// Whether the frames' final renders need depth: written with --depth, or
+// read by a camera's defocus.
+bool NeedsDepth(const RenderJobOptions& options, const RenderInputs& in) {
+  bool need_depth = options.write_depth;
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    if (!in.sensor_active[c]) continue;
+    need_depth = need_depth || in.sensors[c].optics.f_number > 0;
+  }
+  return need_depth;
+}
+
+// What the render steps share: the job and its inputs, the renderer and its
+// last images, the sequence folder being written and the sensor chains.
+struct RenderRun {
+  const RenderJobOptions& options;
+  const RenderInputs& in;
+  Renderer& renderer;
+  const fs::path& root;  // the staging folder
+  RigExposure& exposure;
+  RenderProgress& progress;
+  bool need_depth;
+  std::vector<CameraImages> all_images;  // per camera, reused by every render
+};
+
+// Camera images as the sensor chain reads them.
+CleanRender CleanRenderOf(const CameraImages& images) {
+  return {images.grey, images.radiance, images.depth};
+}
+
+// Renders and writes the empty-stage frames (background/<cam>/), at the
+// camera rate before t = 0 (`background_s` s of them), with the screens'
+// calibration sweep when `sweep_screens`; returns truth/background.jsonl.
+std::string RenderBackground(RenderRun& run, bool sweep_screens, double background_s) {
+  const RenderInputs& in = run.in;
+  const int count = run.options.background_frames;
   std::string background_lines;
-  renderer.SetPersonVisible(false);
-  for (int f = 0; f < options.background_frames; ++f) {
+  run.renderer.SetPersonVisible(false);
+  for (int f = 0; f < count; ++f) {
     ThrowIfCancelled();
-    renderer.RenderAll(&all_images, need_depth);
+    run.renderer.RenderAll(&run.all_images, run.need_depth);
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
-    const double sweep = sweep_screens ? ScreenSweepLevel(f, options.background_frames) : -1.0;
+    const double sweep = sweep_screens ? ScreenSweepLevel(f, count) : -1.0;
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const cv::Mat frame = expose(c, all_images[c], cv::Mat(), 1, t, (1ull << 40) + f, sensor_truth, sweep);
-      WritePngAtomic(root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
+      const cv::Mat frame = run.exposure.Expose(c, CleanRenderOf(run.all_images[c]), cv::Mat(), 1, t,
+                                                (1ull << 40) + f, sensor_truth, sweep);
+      WritePngAtomic(run.root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
     }
     background_lines += nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";
-    ++done;
-    report("background", f, options.background_frames);
+    run.progress.FrameSetDone("background", f, count);
   }
-  for (cv::Mat& m : last_written) m.release();
+  return background_lines;
+}
 
-  // 5. The sequence. With motion blur, sub-frames over the exposure are
-  // rendered and averaged; the last render is always at the frame time, so
-  // masks, depth and visibility belong to the truth's instant.
-  renderer.SetPersonVisible(true);
+// Each camera's capture instant (s) for frame f at time t: t, plus the
+// camera's seeded sync jitter if it has one; sets *jittered when any has.
+std::vector<double> CaptureInstants(const RenderInputs& in, uint64_t seed, int f, double t, bool* jittered) {
+  std::vector<double> instant(in.rig.cameras.size(), t);
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    const double jitter_s = in.sensor_active[c] ? in.sensors[c].capture.sync_jitter_ms / 1000.0 : 0.0;
+    if (jitter_s <= 0) continue;
+    float z0, z1;
+    StandardNormalPair(MixHash(MixHash(seed, 0x5C1Cull + c), uint64_t(f)), &z0, &z1);
+    instant[c] = t + jitter_s * z0;
+    *jittered = true;
+  }
+  return instant;
+}
+
+// Adds a sub-frame's radiance `sources` to `sum` (a copy when `sum` is empty).
+void Accumulate(cv::Mat& sum, const cv::Mat& sources) {
+  if (sum.empty()) sum = sources.clone(); else sum += sources;
+}
+
+// Renders one frame-set into run.all_images, each camera at `instant[c]` (s),
+// the final render of each at its instant; with motion blur, the sub-frames'
+// radiance (and the final one's when it counts) is summed into
+// `radiance_sums`. Unless `jittered`, the cameras share every render.
+void RenderFrameSet(RenderRun& run,
+                    const MotionBlurPlan& blur,
+                    double t,
+                    const std::vector<double>& instant,
+                    bool jittered,
+                    std::vector<MeshVertex>& skinned,
+                    std::vector<cv::Mat>& radiance_sums) {
+  const RenderInputs& in = run.in;
+  std::vector<CameraImages>& all_images = run.all_images;
+  for (cv::Mat& sum : radiance_sums) sum.release();
+  if (!jittered) {
+    // Synchronised cameras share every render.
+    for (double offset : blur.offsets) {
+      PoseAndUpload(in, t + offset, run.renderer, skinned);
+      run.renderer.RenderAll(&all_images, false);
+      for (size_t c = 0; c < all_images.size(); ++c) Accumulate(radiance_sums[c], all_images[c].radiance);
+    }
+    PoseAndUpload(in, t, run.renderer, skinned);
+    run.renderer.RenderAll(&all_images, run.need_depth);
+    for (size_t c = 0; blur.centre_counts && c < all_images.size(); ++c) {
+      Accumulate(radiance_sums[c], all_images[c].radiance);
+    }
+  } else {
+    // Each camera sees the person at its own instant (skinned per camera).
+    all_images.resize(in.rig.cameras.size());
+    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+      for (double offset : blur.offsets) {
+        PoseAndUpload(in, instant[c] + offset, run.renderer, skinned);
+        run.renderer.Render(static_cast<int>(c), &all_images[c], false);
+        Accumulate(radiance_sums[c], all_images[c].radiance);
+      }
+      PoseAndUpload(in, instant[c], run.renderer, skinned);
+      run.renderer.Render(static_cast<int>(c), &all_images[c], run.need_depth);
+      if (blur.centre_counts) Accumulate(radiance_sums[c], all_images[c].radiance);
+    }
+  }
+}
+
+// Exposes frame f (time t, s) of every camera from run.all_images and writes
+// it, its mask and (with --depth) its depth; returns the sensor truth per
+// camera, with each camera's sync offset (ms).
+nlohmann::json ExposeAndWriteFrameSet(RenderRun& run,
+                                      const MotionBlurPlan& blur,
+                                      int f,
+                                      double t,
+                                      const std::vector<double>& instant,
+                                      const std::vector<cv::Mat>& radiance_sums) {
+  const RenderInputs& in = run.in;
+  const fs::path& root = run.root;
+  nlohmann::json sensor_truth = nlohmann::json::object();
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    const std::string& cam_name = in.rig.cameras[c].name;
+    const cv::Mat frame = run.exposure.Expose(c, CleanRenderOf(run.all_images[c]), radiance_sums[c], blur.samples,
+                                              instant[c], f, sensor_truth);
+    sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
+    WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
+    WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), run.all_images[c].mask);
+    if (run.options.write_depth) {
+      WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"),
+                          run.all_images[c].depth);
+    }
+  }
+  return sensor_truth;
+}
+
+// Frame f's line of truth/frames.jsonl (time t, s): whether the person is on
+// the stage, the joints in the world (m) and in each camera (px, visibility),
+// the motion's labels and pointing, and the sensor truth.
+nlohmann::json TruthLine(const RenderInputs& in,
+                         const Labeler& labeler,
+                         int f,
+                         double t,
+                         const FrameTruth& truth,
+                         const nlohmann::json& sensor_truth) {
+  const auto& joint_names = TruthJointNames();
+  nlohmann::json line;
+  line["frame"] = f;
+  line["t"] = t;
+  const Eigen::Vector3d& root_point = truth.joints3d[0];
+  const Eigen::Vector2d stage_offset = root_point.head<2>() - in.scene.stage_center;
+  line["present"] = std::abs(stage_offset.x()) <= in.scene.stage_size.x() / 2 &&
+                    std::abs(stage_offset.y()) <= in.scene.stage_size.y() / 2;
+  nlohmann::json joints3d = nlohmann::json::object();
+  for (size_t j = 0; j < joint_names.size(); ++j) joints3d[joint_names[j]] = Vec(truth.joints3d[j]);
+  line["joints3d"] = joints3d;
+  nlohmann::json joints2d = nlohmann::json::object();
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    nlohmann::json per_cam = nlohmann::json::object();
+    for (size_t j = 0; j < joint_names.size(); ++j) {
+      const Eigen::Vector3d& uvv = truth.joints2d[c][j];
+      per_cam[joint_names[j]] = {uvv.x(), uvv.y(), static_cast<int>(uvv.z())};
+    }
+    joints2d[in.rig.cameras[c].name] = per_cam;
+  }
+  line["joints2d"] = joints2d;
+  line["labels"] = labeler.Labels(t);
+  line["pointing"] = labeler.Pointing(t);
+  line["sensor"] = sensor_truth;
+  return line;
+}
+
+// Renders and writes the sequence's frames from t = 0 (frames/, truth/masks/,
+// truth/depth/). With motion blur, sub-frames over the exposure are rendered
+// and averaged; the last render is always at the frame time, so masks, depth
+// and visibility belong to the truth's instant. Returns truth/frames.jsonl.
+std::string RenderSequence(RenderRun& run, const MotionBlurPlan& blur) {
+  const RenderInputs& in = run.in;
+  run.renderer.SetPersonVisible(true);
   std::vector<MeshVertex> skinned;
   std::string truth_lines;
   const Labeler labeler(in.avatar, &in.scene, *in.motion);
-  const auto& joint_names = TruthJointNames();
   std::vector<cv::Mat> radiance_sums(in.rig.cameras.size());
-  // Sub-frame offsets over the exposure; with an odd count the centre one is
-  // the final render at the camera's instant.
-  std::vector<double> offsets;
-  for (int k = 0; blur_samples > 1 && k < blur_samples; ++k) {
-    const double offset = ((k + 0.5) / blur_samples - 0.5) * blur_exposure_s;
-    if (std::abs(offset) > 1e-12) offsets.push_back(offset);
-  }
-  const bool centre_counts = blur_samples > 1 && blur_samples % 2 == 1;
   for (int f = 0; f < in.frame_count; ++f) {
     ThrowIfCancelled();
     const double t = f / in.fps;
-    // Each camera's instant: the frame time, plus its sync jitter if any.
-    std::vector<double> instant(in.rig.cameras.size(), t);
     bool jittered = false;
-    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const double jitter_s = in.sensor_active[c] ? in.sensors[c].capture.sync_jitter_ms / 1000.0 : 0.0;
-      if (jitter_s <= 0) continue;
-      float z0, z1;
-      StandardNormalPair(MixHash(MixHash(options.seed, 0x5C1Cull + c), uint64_t(f)), &z0, &z1);
-      instant[c] = t + jitter_s * z0;
-      jittered = true;
-    }
-    auto accumulate = [&](size_t c, const cv::Mat& sources) {
-      if (radiance_sums[c].empty()) radiance_sums[c] = sources.clone(); else radiance_sums[c] += sources;
-    };
-    for (cv::Mat& sum : radiance_sums) sum.release();
-    if (!jittered) {
-      // Synchronised cameras share every render.
-      for (double offset : offsets) {
-        PoseAndUpload(in, t + offset, renderer, skinned);
-        renderer.RenderAll(&all_images, false);
-        for (size_t c = 0; c < all_images.size(); ++c) accumulate(c, all_images[c].radiance);
-      }
-      PoseAndUpload(in, t, renderer, skinned);
-      renderer.RenderAll(&all_images, need_depth);
-      for (size_t c = 0; centre_counts && c < all_images.size(); ++c) accumulate(c, all_images[c].radiance);
-    } else {
-      // Each camera sees the person at its own instant (skinned per camera).
-      all_images.resize(in.rig.cameras.size());
-      for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-        for (double offset : offsets) {
-          PoseAndUpload(in, instant[c] + offset, renderer, skinned);
-          renderer.Render(static_cast<int>(c), &all_images[c], false);
-          accumulate(c, all_images[c].radiance);
-        }
-        PoseAndUpload(in, instant[c], renderer, skinned);
-        renderer.Render(static_cast<int>(c), &all_images[c], need_depth);
-        if (centre_counts) accumulate(c, all_images[c].radiance);
-      }
-    }
+    const std::vector<double> instant = CaptureInstants(in, run.options.seed, f, t, &jittered);
+    RenderFrameSet(run, blur, t, instant, jittered, skinned, radiance_sums);
     const JointTransforms world_from_joint =
         ForwardKinematics(in.avatar.skeleton, in.motion->At(t));
-    nlohmann::json sensor_truth = nlohmann::json::object();
-    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      const std::string& cam_name = in.rig.cameras[c].name;
-      const cv::Mat frame = expose(c, all_images[c], radiance_sums[c], blur_samples, instant[c], f, sensor_truth);
-      sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
-      WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
-      WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), all_images[c].mask);
-      if (options.write_depth) {
-        WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"),
-                            all_images[c].depth);
-      }
-    }
-    const FrameTruth truth = ComputeFrameTruth(in, world_from_joint, renderer);
-    nlohmann::json line;
-    line["frame"] = f;
-    line["t"] = t;
-    const Eigen::Vector3d& root_point = truth.joints3d[0];
-    const Eigen::Vector2d stage_offset = root_point.head<2>() - in.scene.stage_center;
-    line["present"] = std::abs(stage_offset.x()) <= in.scene.stage_size.x() / 2 &&
-                      std::abs(stage_offset.y()) <= in.scene.stage_size.y() / 2;
-    nlohmann::json joints3d = nlohmann::json::object();
-    for (size_t j = 0; j < joint_names.size(); ++j) joints3d[joint_names[j]] = Vec(truth.joints3d[j]);
-    line["joints3d"] = joints3d;
-    nlohmann::json joints2d = nlohmann::json::object();
-    for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-      nlohmann::json per_cam = nlohmann::json::object();
-      for (size_t j = 0; j < joint_names.size(); ++j) {
-        const Eigen::Vector3d& uvv = truth.joints2d[c][j];
-        per_cam[joint_names[j]] = {uvv.x(), uvv.y(), static_cast<int>(uvv.z())};
-      }
-      joints2d[in.rig.cameras[c].name] = per_cam;
-    }
-    line["joints2d"] = joints2d;
-    line["labels"] = labeler.Labels(t);
-    line["pointing"] = labeler.Pointing(t);
-    line["sensor"] = sensor_truth;
-    truth_lines += line.dump() + "\n";
-    ++done;
-    report("frame", f, in.frame_count);
+    const nlohmann::json sensor_truth = ExposeAndWriteFrameSet(run, blur, f, t, instant, radiance_sums);
+    const FrameTruth truth = ComputeFrameTruth(in, world_from_joint, run.renderer);
+    truth_lines += TruthLine(in, labeler, f, t, truth, sensor_truth).dump() + "\n";
+    run.progress.FrameSetDone("frame", f, in.frame_count);
   }
-  AtomicWriteFile(root / "truth" / "frames.jsonl", truth_lines);
-  AtomicWriteFile(root / "truth" / "background.jsonl", background_lines);
+  return truth_lines;
+}
+
+// Writes the motion's events (truth/events.json: times in s and the frames
+// they span) and the motion itself (truth/motion.bvh) under `root`.
+void WriteMotionTruth(const fs::path& root, const RenderInputs& in) {
   nlohmann::json events = nlohmann::json::array();
   for (const MotionEvent& e : in.motion->Events()) {
     events.push_back({{"kind", e.kind},
@@ -479,12 +535,53 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   }
   AtomicWriteFile(root / "truth" / "events.json", events.dump(2) + "\n");
   AtomicWriteFile(root / "truth" / "motion.bvh", WriteBvh(MotionToBvh(*in.motion, in.avatar.skeleton, in.fps, in.frame_count)));
-  AtomicWriteFile(root / "manifest.json", manifest.dump(2) + "\n");
+}
+
+}  // namespace
+
+fs::path RunRenderJob(const RenderJobOptions& options) {
+  // 1. Everything from outside is checked before anything is created.
+  const RenderInputs in = LoadRenderInputs(options);
+  const bool sweep_screens = SweepsScreens(options, in);
+  const fs::path out = OutputFolder(options, in);
+
+  // 2. GL and the renderer.
+  auto context = CreateGlContext(options.backend);
+  Log().info("render: {} backend, {}", context->BackendName(), context->RendererString());
+  const RenderOptions render_options = RenderOptionsFor(options, in);
+  Renderer renderer(*context, in.rig.cameras, render_options);
+  renderer.SetScene(in.scene);
+  renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
+
+  // 3. The staging folder and the static files.
+  StagingDir staging(out, options.overwrite, "--out");
+  const fs::path root = staging.path();
+  CreateSequenceFolders(root, in, options.write_depth);
+  WriteSequenceCalibration(root, in);
+  const nlohmann::json manifest = BuildManifest(options, in, sweep_screens, *context, render_options);
+
+  RenderProgress progress;
+  const int total = options.background_frames + in.frame_count;
+  // The sensor model per camera; background frames come before t = 0.
+  const double background_s = options.background_frames / in.fps;
+  RigExposure exposure(in.rig.cameras, in.sensors, in.sensor_active, options.seed, -background_s,
+                       in.frame_count / in.fps);
+  const MotionBlurPlan blur = PlanMotionBlur(in);
+  RenderRun run{options, in, renderer, root, exposure, progress, NeedsDepth(options, in), {}};
+
+  // 4. Empty-stage frames.
+  const std::string background_lines = RenderBackground(run, sweep_screens, background_s);
+  exposure.ForgetLastFrames();
+
+  // 5. The sequence, then the truth files and the manifest.
+  const std::string truth_lines = RenderSequence(run, blur);
+  AtomicWriteFile(root / "truth" / "frames.jsonl", truth_lines);
+  AtomicWriteFile(root / "truth" / "background.jsonl", background_lines);
+  WriteMotionTruth(root, in);
+  WriteManifest(root, manifest);
   ThrowIfCancelled();
   staging.Commit();
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  Log().info("render: {} frame-sets ({} cameras) in {:.1f} s", total, in.rig.cameras.size(), elapsed);
+  Log().info("render: {} frame-sets ({} cameras) in {:.1f} s", total, in.rig.cameras.size(), progress.ElapsedS());
   return staging.final_path();
 }
 

@@ -67,6 +67,7 @@ struct RenderInputs {
   // Per camera: the sensor preset with the rig's per-knob overrides.
   std::vector<SensorSetup> sensors;
   std::vector<bool> sensor_active;  // false: the clean render is written as is
+  bool models_sensor = false;       // the preset models a sensor (not `clean`)
 };
 
 RenderInputs LoadRenderInputs(const RenderJobOptions& options);
@@ -78,7 +79,7 @@ bool SweepsScreens(const RenderJobOptions& options, const RenderInputs& in);
 
 // The renderer's options for a job: its supersampling, and shadows unless
 // turned off (default: on for every sensor preset but clean).
-RenderOptions RenderOptionsFor(const RenderJobOptions& options);
+RenderOptions RenderOptionsFor(const RenderJobOptions& options, const RenderInputs& in);
 
 // Per-frame truth joints and their projections, for one posed frame.
 struct FrameTruth {

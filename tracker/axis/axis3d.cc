@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "common/error.h"
+
 namespace irbench {
 namespace {
 
@@ -45,8 +47,7 @@ PreparedView Prepare(const AxisView& view, const Axis3dOptions& options) {
     const auto slot = std::find(kImageParts.begin(), kImageParts.end(), view.labels[i]);
     if (slot == kImageParts.end()) continue;
     const Eigen::Vector2d& px = view.graph.points[i].px;
-    const auto x = view.camera.Undistort({(px.x() - view.camera.cx) / view.camera.fx,
-                                          (px.y() - view.camera.cy) / view.camera.fy});
+    const auto x = view.camera.UndistortPixel(px);
     if (!x) continue;
     out.normalized[i] = *x;
     out.members[slot - kImageParts.begin()].push_back(int(i));
@@ -99,34 +100,9 @@ std::optional<Eigen::Vector3d> TriangulateMidpoint(const Eigen::Vector3d& center
   return 0.5 * (center_a + s * ray_a + center_b + t * ray_b);
 }
 
-}  // namespace
-
-void Axis3dOptions::Check() const {
-  if (!(min_epipolar_angle_deg >= 0 && min_epipolar_angle_deg < 90)) {
-    throw std::invalid_argument("Axis3dOptions.min_epipolar_angle_deg must be in [0, 90)");
-  }
-  if (!(min_ray_angle_deg >= 0 && min_ray_angle_deg < 90)) {
-    throw std::invalid_argument("Axis3dOptions.min_ray_angle_deg must be in [0, 90)");
-  }
-  if (!(link_px > 0)) throw std::invalid_argument("Axis3dOptions.link_px must be > 0");
-  if (!(silhouette_tolerance_px >= 0)) throw std::invalid_argument("Axis3dOptions.silhouette_tolerance_px must be >= 0");
-  if (!(min_diameter_fraction >= 0 && min_diameter_fraction < 1)) {
-    throw std::invalid_argument("Axis3dOptions.min_diameter_fraction must be in [0, 1)");
-  }
-  if (!(merge_radius_m >= 0)) throw std::invalid_argument("Axis3dOptions.merge_radius_m must be >= 0");
-}
-
-void BodyAxesOptions::Check() const {
-  points.Check();
-  parts.Check();
-  axis3d.Check();
-  if (!(max_view_elevation_deg >= 0 && max_view_elevation_deg <= 90)) {
-    throw std::invalid_argument("BodyAxesOptions.max_view_elevation_deg must be in [0, 90]");
-  }
-}
-
-std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, const Axis3dOptions& options) {
-  options.Check();
+// Throws std::invalid_argument when a view's silhouette, labels or distance
+// map do not fit its camera and graph.
+void CheckViews(const std::vector<AxisView>& views) {
   for (const AxisView& view : views) {
     if (view.silhouette.type() != CV_8UC1 || view.silhouette.cols != view.camera.width ||
         view.silhouette.rows != view.camera.height) {
@@ -143,110 +119,110 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
                                   "' is not CV_32FC1 of the camera's size");
     }
   }
-  std::vector<PreparedView> prepared(views.size());
-  cv::parallel_for_(cv::Range(0, int(views.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) prepared[i] = Prepare(views[i], options);
-  });
+}
 
-  // Whether X projects onto (or near) every silhouette that sees it; counts them.
-  auto support = [&](const Eigen::Vector3d& x) {
-    int count = 0;
-    for (size_t k = 0; k < views.size(); ++k) {
-      const Camera& camera = views[k].camera;
-      if ((camera.cam_from_world * x).z() <= 0) continue;
-      const Eigen::Vector2d px = camera.Project(x);
-      const int u = int(std::lround(px.x())), v = int(std::lround(px.y()));
-      if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
-      if (prepared[k].distance_to_silhouette(v, u) > options.silhouette_tolerance_px) return -1;
-      ++count;
-    }
-    return count;
-  };
-
-  const double min_epipolar_sin = std::sin(options.min_epipolar_angle_deg * kDegToRad);
-  // Every pair of views, in parallel; the points are gathered in pair order,
-  // so the result does not depend on the thread count.
-  std::vector<std::pair<size_t, size_t>> pairs;
-  for (size_t i = 0; i < views.size(); ++i) {
-    for (size_t j = i + 1; j < views.size(); ++j) pairs.emplace_back(i, j);
+// Whether X projects onto (or near) every silhouette that sees it; counts them
+// (-1: some silhouette is missed).
+int Support(const std::vector<AxisView>& views,
+            const std::vector<PreparedView>& prepared,
+            const Axis3dOptions& options,
+            const Eigen::Vector3d& x) {
+  int count = 0;
+  for (size_t k = 0; k < views.size(); ++k) {
+    const Camera& camera = views[k].camera;
+    if ((camera.cam_from_world * x).z() <= 0) continue;
+    const Eigen::Vector2d px = camera.Project(x);
+    const int u = int(std::lround(px.x())), v = int(std::lround(px.y()));
+    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
+    if (prepared[k].distance_to_silhouette(v, u) > options.silhouette_tolerance_px) return -1;
+    ++count;
   }
-  std::vector<std::vector<AxisPoint3d>> per_pair(pairs.size());
-  cv::parallel_for_(cv::Range(0, int(pairs.size())), [&](const cv::Range& r) {
-    for (int pair = r.start; pair < r.end; ++pair) {
-      const auto [i, j] = pairs[pair];
-      std::vector<AxisPoint3d>& found = per_pair[pair];
-      const PreparedView& vi = prepared[i];
-      const PreparedView& vj = prepared[j];
-      // Essential matrix mapping normalised points of i to epipolar lines of j.
-      const Eigen::Matrix3d j_from_i = vj.cam_from_world_rotation * vi.cam_from_world_rotation.transpose();
-      const Eigen::Vector3d t_j_from_i = vj.cam_from_world_translation - j_from_i * vi.cam_from_world_translation;
-      const Eigen::Matrix3d essential = Skew(t_j_from_i) * j_from_i;
-      const Eigen::Vector3d epipole_in_i = vi.cam_from_world_rotation * vj.center_in_world + vi.cam_from_world_translation;
-      for (size_t pa = 0; pa < kImageParts.size(); ++pa) {
-        for (size_t pb = 0; pb < kImageParts.size(); ++pb) {
-          const bool arms = IsArm(kImageParts[pa]) && IsArm(kImageParts[pb]);
-          if (pa != pb && !arms) continue;
-          const BodyPart part3d = arms ? BodyPart::kArm : kImageParts[pa];
-          for (int a : vi.members[pa]) {
-            const Eigen::Vector2d& xa = vi.normalized[a];
-            const Eigen::Vector3d line = essential * xa.homogeneous();
-            const double line_norm = line.head<2>().norm();
-            if (line_norm < 1e-12) continue;
-            const Eigen::Vector2d line_dir = Eigen::Vector2d(-line.y(), line.x()) / line_norm;
-            // The coplanar case seen from view i: the epipolar line through a
-            // (towards the epipole, camera j's centre) runs along a's own axis.
-            const Eigen::Vector3d line_in_i = xa.homogeneous().cross(epipole_in_i);
-            const Eigen::Vector2d& axis_a = views[i].graph.points[a].axis_dir;
-            if (line_in_i.head<2>().norm() > 1e-12 && axis_a.norm() > 0.5 &&
-                std::abs(axis_a.dot(line_in_i.head<2>().normalized())) < min_epipolar_sin) {
-              continue;
-            }
-            for (const auto& [b1, b2] : vj.edges[pb]) {
-              const double s1 = line.dot(vj.normalized[b1].homogeneous());
-              const double s2 = line.dot(vj.normalized[b2].homogeneous());
-              if (s1 * s2 > 0 || s1 == s2) continue;
-              const AxisPoint2d& q1 = views[j].graph.points[b1];
-              const AxisPoint2d& q2 = views[j].graph.points[b2];
-              Eigen::Vector2d axis = q1.axis_dir + (q1.axis_dir.dot(q2.axis_dir) < 0 ? -1.0 : 1.0) * q2.axis_dir;
-              if (axis.norm() < 1e-9) axis = q2.px - q1.px;
-              axis.normalize();
-              // |sin| of the angle between the epipolar line and the 2D axis.
-              if (std::abs(axis.x() * line_dir.y() - axis.y() * line_dir.x()) < min_epipolar_sin) continue;
-              const double lambda = s1 / (s1 - s2);
-              const Eigen::Vector2d xb = vj.normalized[b1] + lambda * (vj.normalized[b2] - vj.normalized[b1]);
-              const Eigen::Vector3d ray_a = (vi.cam_from_world_rotation.transpose() * xa.homogeneous()).normalized();
-              const Eigen::Vector3d ray_b = (vj.cam_from_world_rotation.transpose() * xb.homogeneous()).normalized();
-              const auto x = TriangulateMidpoint(vi.center_in_world, ray_a, vj.center_in_world, ray_b,
-                                                 options.min_ray_angle_deg * kDegToRad);
-              if (!x) continue;
-              const int count = support(*x);
-              if (count < 2) continue;
-              const double depth_a = (views[i].camera.cam_from_world * *x).z();
-              const double depth_b = (views[j].camera.cam_from_world * *x).z();
-              const double diameter_b_px = q1.diameter_px + lambda * (q2.diameter_px - q1.diameter_px);
-              AxisPoint3d point;
-              point.p_in_world = *x;
-              point.part = part3d;
-              point.diameter_m = 0.5 * (views[i].graph.points[a].diameter_px * depth_a / views[i].camera.fx +
-                                        diameter_b_px * depth_b / views[j].camera.fx);
-              point.camera_a = int(i);
-              point.camera_b = int(j);
-              point.support = count;
-              found.push_back(point);
-            }
-          }
+  return count;
+}
+
+// The 3D axis points of views i and j: each labelled point of i meets the
+// matching part's polyline in j along its epipolar line, and the two rays
+// triangulate; in the order of the parts, i's points and j's edges.
+// min_epipolar_sin: sin(options.min_epipolar_angle_deg).
+std::vector<AxisPoint3d> TriangulatePair(const std::vector<AxisView>& views,
+                                         const std::vector<PreparedView>& prepared,
+                                         size_t i,
+                                         size_t j,
+                                         double min_epipolar_sin,
+                                         const Axis3dOptions& options) {
+  std::vector<AxisPoint3d> found;
+  const PreparedView& vi = prepared[i];
+  const PreparedView& vj = prepared[j];
+  // Essential matrix mapping normalised points of i to epipolar lines of j.
+  const Eigen::Matrix3d j_from_i = vj.cam_from_world_rotation * vi.cam_from_world_rotation.transpose();
+  const Eigen::Vector3d t_j_from_i = vj.cam_from_world_translation - j_from_i * vi.cam_from_world_translation;
+  const Eigen::Matrix3d essential = Skew(t_j_from_i) * j_from_i;
+  const Eigen::Vector3d epipole_in_i = vi.cam_from_world_rotation * vj.center_in_world + vi.cam_from_world_translation;
+  for (size_t pa = 0; pa < kImageParts.size(); ++pa) {
+    for (size_t pb = 0; pb < kImageParts.size(); ++pb) {
+      const bool arms = IsArm(kImageParts[pa]) && IsArm(kImageParts[pb]);
+      if (pa != pb && !arms) continue;
+      const BodyPart part3d = arms ? BodyPart::kArm : kImageParts[pa];
+      for (int a : vi.members[pa]) {
+        const Eigen::Vector2d& xa = vi.normalized[a];
+        const Eigen::Vector3d line = essential * xa.homogeneous();
+        const double line_norm = line.head<2>().norm();
+        if (line_norm < 1e-12) continue;
+        const Eigen::Vector2d line_dir = Eigen::Vector2d(-line.y(), line.x()) / line_norm;
+        // The coplanar case seen from view i: the epipolar line through a
+        // (towards the epipole, camera j's centre) runs along a's own axis.
+        const Eigen::Vector3d line_in_i = xa.homogeneous().cross(epipole_in_i);
+        const Eigen::Vector2d& axis_a = views[i].graph.points[a].axis_dir;
+        if (line_in_i.head<2>().norm() > 1e-12 && axis_a.norm() > 0.5 &&
+            std::abs(axis_a.dot(line_in_i.head<2>().normalized())) < min_epipolar_sin) {
+          continue;
+        }
+        for (const auto& [b1, b2] : vj.edges[pb]) {
+          const double s1 = line.dot(vj.normalized[b1].homogeneous());
+          const double s2 = line.dot(vj.normalized[b2].homogeneous());
+          if (s1 * s2 > 0 || s1 == s2) continue;
+          const AxisPoint2d& q1 = views[j].graph.points[b1];
+          const AxisPoint2d& q2 = views[j].graph.points[b2];
+          Eigen::Vector2d axis = q1.axis_dir + (q1.axis_dir.dot(q2.axis_dir) < 0 ? -1.0 : 1.0) * q2.axis_dir;
+          if (axis.norm() < 1e-9) axis = q2.px - q1.px;
+          axis.normalize();
+          // |sin| of the angle between the epipolar line and the 2D axis.
+          if (std::abs(axis.x() * line_dir.y() - axis.y() * line_dir.x()) < min_epipolar_sin) continue;
+          const double lambda = s1 / (s1 - s2);
+          const Eigen::Vector2d xb = vj.normalized[b1] + lambda * (vj.normalized[b2] - vj.normalized[b1]);
+          const Eigen::Vector3d ray_a = (vi.cam_from_world_rotation.transpose() * xa.homogeneous()).normalized();
+          const Eigen::Vector3d ray_b = (vj.cam_from_world_rotation.transpose() * xb.homogeneous()).normalized();
+          const auto x = TriangulateMidpoint(vi.center_in_world, ray_a, vj.center_in_world, ray_b,
+                                             options.min_ray_angle_deg * kDegToRad);
+          if (!x) continue;
+          const int count = Support(views, prepared, options, *x);
+          if (count < 2) continue;
+          const double depth_a = (views[i].camera.cam_from_world * *x).z();
+          const double depth_b = (views[j].camera.cam_from_world * *x).z();
+          const double diameter_b_px = q1.diameter_px + lambda * (q2.diameter_px - q1.diameter_px);
+          AxisPoint3d point;
+          point.p_in_world = *x;
+          point.part = part3d;
+          point.diameter_m = 0.5 * (views[i].graph.points[a].diameter_px * depth_a / views[i].camera.fx +
+                                    diameter_b_px * depth_b / views[j].camera.fx);
+          point.camera_a = int(i);
+          point.camera_b = int(j);
+          point.support = count;
+          found.push_back(point);
         }
       }
     }
-  });
-  std::vector<AxisPoint3d> raw;
-  for (const std::vector<AxisPoint3d>& found : per_pair) raw.insert(raw.end(), found.begin(), found.end());
-  if (options.merge_radius_m <= 0) return raw;
+  }
+  return found;
+}
 
-  // Greedy merge of one part's points within merge_radius_m of a seed, in
-  // index order. The points are binned in cubes of that edge: those within
-  // the radius of a seed lie in the 27 cubes about its own, and taken in
-  // index order they give the plain scan's sums.
+// Greedy merge of one part's points within merge_radius_m (> 0) of a seed, in
+// index order: each merged point averages its group.
+std::vector<AxisPoint3d> MergeNearby(const std::vector<AxisPoint3d>& raw,
+                                     const Axis3dOptions& options) {
+  // The points are binned in cubes of that edge: those within the radius of a
+  // seed lie in the 27 cubes about its own, and taken in index order they give
+  // the plain scan's sums.
   std::vector<AxisPoint3d> merged;
   std::vector<bool> used(raw.size(), false);
   const double radius2 = options.merge_radius_m * options.merge_radius_m;
@@ -297,6 +273,60 @@ std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, c
     merged.push_back(sum);
   }
   return merged;
+}
+
+}  // namespace
+
+void Axis3dOptions::Check() const {
+  if (!(min_epipolar_angle_deg >= 0 && min_epipolar_angle_deg < 90)) {
+    throw InputError("", "Axis3dOptions.min_epipolar_angle_deg", "must be in [0, 90)");
+  }
+  if (!(min_ray_angle_deg >= 0 && min_ray_angle_deg < 90)) {
+    throw InputError("", "Axis3dOptions.min_ray_angle_deg", "must be in [0, 90)");
+  }
+  if (!(link_px > 0)) throw InputError("", "Axis3dOptions.link_px", "must be > 0");
+  if (!(silhouette_tolerance_px >= 0)) throw InputError("", "Axis3dOptions.silhouette_tolerance_px", "must be >= 0");
+  if (!(min_diameter_fraction >= 0 && min_diameter_fraction < 1)) {
+    throw InputError("", "Axis3dOptions.min_diameter_fraction", "must be in [0, 1)");
+  }
+  if (!(merge_radius_m >= 0)) throw InputError("", "Axis3dOptions.merge_radius_m", "must be >= 0");
+}
+
+void BodyAxesOptions::Check() const {
+  points.Check();
+  parts.Check();
+  axis3d.Check();
+  if (!(max_view_elevation_deg >= 0 && max_view_elevation_deg <= 90)) {
+    throw InputError("", "BodyAxesOptions.max_view_elevation_deg", "must be in [0, 90]");
+  }
+}
+
+std::vector<AxisPoint3d> ReconstructAxis3d(const std::vector<AxisView>& views, const Axis3dOptions& options) {
+  options.Check();
+  CheckViews(views);
+  std::vector<PreparedView> prepared(views.size());
+  cv::parallel_for_(cv::Range(0, int(views.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) prepared[i] = Prepare(views[i], options);
+  });
+
+  const double min_epipolar_sin = std::sin(options.min_epipolar_angle_deg * kDegToRad);
+  // Every pair of views, in parallel; the points are gathered in pair order,
+  // so the result does not depend on the thread count.
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (size_t i = 0; i < views.size(); ++i) {
+    for (size_t j = i + 1; j < views.size(); ++j) pairs.emplace_back(i, j);
+  }
+  std::vector<std::vector<AxisPoint3d>> per_pair(pairs.size());
+  cv::parallel_for_(cv::Range(0, int(pairs.size())), [&](const cv::Range& r) {
+    for (int pair = r.start; pair < r.end; ++pair) {
+      const auto [i, j] = pairs[pair];
+      per_pair[pair] = TriangulatePair(views, prepared, i, j, min_epipolar_sin, options);
+    }
+  });
+  std::vector<AxisPoint3d> raw;
+  for (const std::vector<AxisPoint3d>& found : per_pair) raw.insert(raw.end(), found.begin(), found.end());
+  if (options.merge_radius_m <= 0) return raw;
+  return MergeNearby(raw, options);
 }
 
 AxisView MakeAxisView(const Camera& camera, const cv::Mat& silhouette, const BodyAxesOptions& options) {

@@ -10,7 +10,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 #include "tracker/axis/axis_points.h"
 #include "tracker/axis/body_parts.h"
 
@@ -58,7 +58,7 @@ struct Axis3dOptions {
   double silhouette_tolerance_px = 1.5;
   // Triangulated points of one part closer than this are averaged (0: off), m.
   double merge_radius_m = 0.01;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 // Thesis 4.4.2: triangulates head, torso and arm axes across every pair of
@@ -77,7 +77,7 @@ struct BodyAxesOptions {
   // horizontal (an overhead camera) get no body parts: thesis 3.3's rules need
   // an upright person; they still check 3D points against their silhouette.
   double max_view_elevation_deg = 60;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 // One camera's 2D stages: its axis graph (3.2) and, unless the camera looks

@@ -1,6 +1,7 @@
 // 3D axis points (thesis 4.4.2) of a capsule seen by calibrated cameras; the
 // silhouettes are ray-traced against the capsule, so the true axis is exact.
 
+#include "common/error.h"
 #include "tracker/axis/axis3d.h"
 
 #include <gtest/gtest.h>
@@ -137,10 +138,10 @@ TEST(Axis3dTest, OptionsRejectBadValues) {
   Axis3dOptions options;
   EXPECT_NO_THROW(options.Check());
   options.min_epipolar_angle_deg = 95;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), InputError);
   BodyAxesOptions all;
   all.max_view_elevation_deg = -1;
-  EXPECT_THROW(all.Check(), std::invalid_argument);
+  EXPECT_THROW(all.Check(), InputError);
   EXPECT_THROW(ReconstructBodyAxes({Camera{}}, {}), std::invalid_argument);
 }
 

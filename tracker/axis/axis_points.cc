@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "common/error.h"
+
 namespace irbench {
 namespace {
 
@@ -97,9 +99,9 @@ Eigen::Vector2d ScanStep(ScanDirection direction) {
 }
 
 void AxisPointOptions::Check() const {
-  if (min_run_px < 1) throw std::invalid_argument("AxisPointOptions.min_run_px must be >= 1");
-  if (!(keep_slack >= 0 && keep_slack < 1)) throw std::invalid_argument("AxisPointOptions.keep_slack must be in [0, 1)");
-  if (axis_fit_hops < 1) throw std::invalid_argument("AxisPointOptions.axis_fit_hops must be >= 1");
+  if (min_run_px < 1) throw InputError("", "AxisPointOptions.min_run_px", "must be >= 1");
+  if (!(keep_slack >= 0 && keep_slack < 1)) throw InputError("", "AxisPointOptions.keep_slack", "must be in [0, 1)");
+  if (axis_fit_hops < 1) throw InputError("", "AxisPointOptions.axis_fit_hops", "must be >= 1");
 }
 
 AxisGraph ExtractAxisPoints(const cv::Mat& silhouette, const AxisPointOptions& options) {

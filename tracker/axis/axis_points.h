@@ -59,7 +59,7 @@ struct AxisPointOptions {
   double keep_slack = 0.08;
   // Neighbour hops on each side used to estimate the local axis direction.
   int axis_fit_hops = 3;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 // Thesis 3.2: scans `silhouette` (CV_8UC1, foreground > 0) with horizontal,

@@ -1,6 +1,7 @@
 // 2D axis points (thesis 3.2) on silhouettes whose axis and width are known
 // analytically.
 
+#include "common/error.h"
 #include "tracker/axis/axis_points.h"
 
 #include <gtest/gtest.h>
@@ -118,10 +119,10 @@ TEST(AxisPointsTest, OptionsRejectBadValues) {
   AxisPointOptions options;
   EXPECT_NO_THROW(options.Check());
   options.min_run_px = 0;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), InputError);
   options = {};
   options.keep_slack = -0.1;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), InputError);
   EXPECT_THROW(ExtractAxisPoints(cv::Mat()), std::invalid_argument);
   EXPECT_THROW(ExtractAxisPoints(cv::Mat(10, 10, CV_32F)), std::invalid_argument);
 }

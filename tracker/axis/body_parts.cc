@@ -7,6 +7,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "common/error.h"
+
 namespace irbench {
 namespace {
 
@@ -22,46 +24,25 @@ int Find(std::vector<int>& parent, int i) {
   return i;
 }
 
-}  // namespace
+// The person: the largest 8-connected blob of a silhouette.
+struct LargestBlob {
+  cv::Rect sil_box;   // the labelled part of the image (blob_id's pixel (0, 0) is its tl())
+  cv::Mat1i blob_id;  // labels within sil_box
+  int id = 0;         // the largest blob's label
+  // Its extent, in blob_id's pixels (inclusive).
+  int left = 0, right = 0, top = 0, bottom = 0;
+};
 
-const char* BodyPartName(BodyPart part) {
-  switch (part) {
-    case BodyPart::kNone: return "none";
-    case BodyPart::kHead: return "head";
-    case BodyPart::kTorso: return "torso";
-    case BodyPart::kLeftImageArm: return "left_image_arm";
-    case BodyPart::kRightImageArm: return "right_image_arm";
-    case BodyPart::kArm: return "arm";
-  }
-  return "?";
-}
-
-void BodyPartOptions::Check() const {
-  auto fraction = [](double v, const char* name) {
-    if (!(v > 0 && v <= 1)) throw std::invalid_argument(std::string("BodyPartOptions.") + name + " must be in (0, 1]");
-  };
-  if (min_blob_area_px < 1) throw std::invalid_argument("BodyPartOptions.min_blob_area_px must be >= 1");
-  fraction(torso_min_width_fraction, "torso_min_width_fraction");
-  fraction(arm_max_width_fraction, "arm_max_width_fraction");
-  fraction(arm_max_height_fraction, "arm_max_height_fraction");
-  fraction(torso_band_fraction, "torso_band_fraction");
-  if (!(link_px > 0)) throw std::invalid_argument("BodyPartOptions.link_px must be > 0");
-  if (min_arm_points < 1) throw std::invalid_argument("BodyPartOptions.min_arm_points must be >= 1");
-}
-
-std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
-                                            const AxisGraph& graph,
-                                            const BodyPartOptions& options) {
-  options.Check();
-  if (silhouette.empty() || silhouette.type() != CV_8UC1 || silhouette.cols != graph.width ||
-      silhouette.rows != graph.height) {
-    throw std::invalid_argument("SegmentBodyParts: the silhouette must be CV_8UC1 of the graph's size");
-  }
-  // The person: the largest 8-connected blob. Labelled within the
-  // silhouette's box (blob_id's pixel (0, 0) is the image's `sil_box.tl()`),
-  // with one pass for the areas and boxes (connectedComponentsWithStats takes
-  // several times longer in OpenCV 4.6).
-  cv::Rect sil_box = cv::boundingRect(silhouette);
+// The largest blob of `silhouette`; nullopt when it is empty or the blob is
+// smaller than min_blob_area_px.
+std::optional<LargestBlob> FindLargestBlob(const cv::Mat& silhouette,
+                                           const BodyPartOptions& options) {
+  // Labelled within the silhouette's box (blob_id's pixel (0, 0) is the
+  // image's `sil_box.tl()`), with one pass for the areas and boxes
+  // (connectedComponentsWithStats takes several times longer in OpenCV 4.6).
+  LargestBlob out;
+  cv::Rect& sil_box = out.sil_box;
+  sil_box = cv::boundingRect(silhouette);
   if (sil_box.empty()) return std::nullopt;
   // OpenCV labels in 2x2 blocks from the image's corner: a box on even rows
   // and columns keeps the blocks, so the blobs are labelled in the whole
@@ -70,7 +51,7 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
   sil_box.x &= ~1;
   sil_box.height += sil_box.y & 1;
   sil_box.y &= ~1;
-  cv::Mat1i blob_id;
+  cv::Mat1i& blob_id = out.blob_id;
   const int count = cv::connectedComponents(silhouette(sil_box) > 0, blob_id, 8, CV_32S);
   std::vector<int> area(count, 0), left(count, blob_id.cols), right(count, -1), top(count, -1), bottom(count, -1);
   for (int y = 0; y < blob_id.rows; ++y) {
@@ -93,60 +74,94 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
     }
   }
   if (best == 0 || best_area < options.min_blob_area_px) return std::nullopt;
-  const int blob_bottom = sil_box.y + bottom[best];
+  out.id = best;
+  out.left = left[best];
+  out.right = right[best];
+  out.top = top[best];
+  out.bottom = bottom[best];
+  return out;
+}
 
-  // Torso centre: the centre of the largest inscribed circle. The distance
-  // transform runs on the blob's box with a ring of background around it:
-  // the nearest background pixel of any blob pixel lies within, so the
-  // values (and the first maximum, row by row) are those of the whole image.
-  // (Outside the silhouette's box all is background: the ring there is
-  // zeros.)
-  const cv::Rect box = cv::Rect(sil_box.x + left[best] - 1, sil_box.y + top[best] - 1, right[best] - left[best] + 3,
-                                bottom[best] - top[best] + 3) &
-                       cv::Rect(0, 0, silhouette.cols, silhouette.rows);
-  cv::Mat1b blob = cv::Mat1b::zeros(box.size());
-  const cv::Rect labelled = box & sil_box;
-  blob(labelled - box.tl()).setTo(255, blob_id(labelled - sil_box.tl()) == best);
-  cv::Mat1f inside;
-  cv::distanceTransform(blob, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+// The largest inscribed circle of the blob.
+struct InscribedCircle {
+  cv::Point center;  // image pixels
   double radius = 0;
-  cv::Point center;
-  cv::minMaxLoc(inside, nullptr, &radius, nullptr, &center);
-  center += box.tl();
+};
 
-  BodyParts2d parts;
-  parts.labels.assign(graph.points.size(), BodyPart::kNone);
-  parts.torso_center_px = Eigen::Vector2d(center.x, center.y);
+// Torso centre: the centre of the blob's largest inscribed circle.
+InscribedCircle TorsoCircle(const cv::Mat& silhouette, const LargestBlob& blob) {
+  // The distance transform runs on the blob's box with a ring of background
+  // around it: the nearest background pixel of any blob pixel lies within, so
+  // the values (and the first maximum, row by row) are those of the whole
+  // image. (Outside the silhouette's box all is background: the ring there
+  // is zeros.)
+  const cv::Rect& sil_box = blob.sil_box;
+  const cv::Rect box = cv::Rect(sil_box.x + blob.left - 1, sil_box.y + blob.top - 1,
+                                blob.right - blob.left + 3, blob.bottom - blob.top + 3) &
+                       cv::Rect(0, 0, silhouette.cols, silhouette.rows);
+  cv::Mat1b blob_mask = cv::Mat1b::zeros(box.size());
+  const cv::Rect labelled = box & sil_box;
+  blob_mask(labelled - box.tl()).setTo(255, blob.blob_id(labelled - sil_box.tl()) == blob.id);
+  cv::Mat1f inside;
+  cv::distanceTransform(blob_mask, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  InscribedCircle out;
+  cv::minMaxLoc(inside, nullptr, &out.radius, nullptr, &out.center);
+  out.center += box.tl();
+  return out;
+}
 
-  auto in_blob = [&](const AxisPoint2d& p) {
-    const int u = std::clamp(int(std::floor(p.px.x())), 0, graph.width - 1);
-    const int v = std::clamp(int(std::floor(p.px.y())), 0, graph.height - 1);
-    return sil_box.contains(cv::Point(u, v)) && blob_id(v - sil_box.y, u - sil_box.x) == best;
-  };
-  // Horizontal axis point of `row` whose run contains column u, or -1.
-  std::map<int, std::vector<int>> horizontal_by_row;
+// Is axis point p (its pixel, clamped to the image) on the largest blob?
+bool InBlob(const AxisGraph& graph, const LargestBlob& blob, const AxisPoint2d& p) {
+  const int u = std::clamp(int(std::floor(p.px.x())), 0, graph.width - 1);
+  const int v = std::clamp(int(std::floor(p.px.y())), 0, graph.height - 1);
+  return blob.sil_box.contains(cv::Point(u, v)) &&
+         blob.blob_id(v - blob.sil_box.y, u - blob.sil_box.x) == blob.id;
+}
+
+// Graph point indices, by row.
+using RunsByRow = std::map<int, std::vector<int>>;
+
+// The blob's horizontal axis points, grouped by row.
+RunsByRow HorizontalRunsByRow(const AxisGraph& graph, const LargestBlob& blob) {
+  RunsByRow horizontal_by_row;
   for (size_t i = 0; i < graph.points.size(); ++i) {
     const AxisPoint2d& p = graph.points[i];
-    if (p.direction == ScanDirection::kHorizontal && in_blob(p)) horizontal_by_row[p.line].push_back(int(i));
-  }
-  auto run_at = [&](int row, double u) {
-    auto it = horizontal_by_row.find(row);
-    if (it == horizontal_by_row.end()) return -1;
-    int nearest = -1;
-    double nearest_gap = 1e9;
-    for (int i : it->second) {
-      const AxisPoint2d& p = graph.points[i];
-      const double gap = u < p.t0 ? p.t0 - u : (u > p.t1 ? u - p.t1 : 0.0);
-      if (gap < nearest_gap) {
-        nearest_gap = gap;
-        nearest = i;
-      }
+    if (p.direction == ScanDirection::kHorizontal && InBlob(graph, blob, p)) {
+      horizontal_by_row[p.line].push_back(int(i));
     }
-    return nearest_gap <= 1.0 ? nearest : -1;
-  };
+  }
+  return horizontal_by_row;
+}
 
+// Horizontal axis point of `row` whose run contains column u, or -1.
+int RunAt(const AxisGraph& graph, const RunsByRow& horizontal_by_row, int row, double u) {
+  auto it = horizontal_by_row.find(row);
+  if (it == horizontal_by_row.end()) return -1;
+  int nearest = -1;
+  double nearest_gap = 1e9;
+  for (int i : it->second) {
+    const AxisPoint2d& p = graph.points[i];
+    const double gap = u < p.t0 ? p.t0 - u : (u > p.t1 ? u - p.t1 : 0.0);
+    if (gap < nearest_gap) {
+      nearest_gap = gap;
+      nearest = i;
+    }
+  }
+  return nearest_gap <= 1.0 ? nearest : -1;
+}
+
+// Torso and head runs, the rows they set (head top, torso top, waist, arm
+// limit), and the torso's median width and column; labels them in `parts`.
+void FindTorsoAndHead(const AxisGraph& graph,
+                      const RunsByRow& horizontal_by_row,
+                      const InscribedCircle& circle,
+                      int blob_bottom,
+                      const BodyPartOptions& options,
+                      BodyParts2d& parts) {
+  const cv::Point& center = circle.center;
+  auto run_at = [&](int row, double u) { return RunAt(graph, horizontal_by_row, row, u); };
   // Torso upwards from the centre: thick horizontal runs through its column.
-  const double thick = options.torso_min_width_fraction * 2 * radius;
+  const double thick = options.torso_min_width_fraction * 2 * circle.radius;
   std::vector<int> torso;
   int row = center.y;
   for (int i; row >= 0 && (i = run_at(row, center.x)) >= 0 && graph.points[i].run_px >= thick; --row) {
@@ -185,16 +200,21 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
   }
   for (int i : parts.torso) parts.labels[i] = BodyPart::kTorso;
   for (int i : parts.head) parts.labels[i] = BodyPart::kHead;
+}
 
-  // Arm candidates: thin kept points beside the torso, outside the head's runs,
-  // above the arm limit.
+// Arm candidates: thin kept points beside the torso, outside the head's runs,
+// above the arm limit.
+std::vector<int> ArmCandidates(const AxisGraph& graph,
+                               const LargestBlob& blob,
+                               const BodyPartOptions& options,
+                               const BodyParts2d& parts) {
   std::map<int, int> head_by_row;
   for (int i : parts.head) head_by_row[graph.points[i].line] = i;
   const double band = options.torso_band_fraction * parts.torso_width_px;
   std::vector<int> candidates;
   for (size_t i = 0; i < graph.points.size(); ++i) {
     const AxisPoint2d& p = graph.points[i];
-    if (!p.kept || parts.labels[i] != BodyPart::kNone || !in_blob(p)) continue;
+    if (!p.kept || parts.labels[i] != BodyPart::kNone || !InBlob(graph, blob, p)) continue;
     if (p.diameter_px > options.arm_max_width_fraction * parts.torso_width_px) continue;
     if (p.px.y() > parts.arm_max_row) continue;
     if (p.px.y() >= parts.torso_top_row && std::abs(p.px.x() - parts.torso_column_px) <= band) continue;
@@ -205,6 +225,15 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
     }
     candidates.push_back(int(i));
   }
+  return candidates;
+}
+
+// The arms: the largest component of the candidates on each side of the torso
+// column, ordered from the shoulder outwards; labels them in `parts`.
+void AssignArms(const AxisGraph& graph,
+                const std::vector<int>& candidates,
+                const BodyPartOptions& options,
+                BodyParts2d& parts) {
   // Components: neighbour links, and links across directions by distance.
   std::vector<int> slot(graph.points.size(), -1);
   for (size_t c = 0; c < candidates.size(); ++c) slot[candidates[c]] = int(c);
@@ -241,6 +270,53 @@ std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
     });
     for (int i : arm) parts.labels[i] = s == 0 ? BodyPart::kLeftImageArm : BodyPart::kRightImageArm;
   }
+}
+
+}  // namespace
+
+const char* BodyPartName(BodyPart part) {
+  switch (part) {
+    case BodyPart::kNone: return "none";
+    case BodyPart::kHead: return "head";
+    case BodyPart::kTorso: return "torso";
+    case BodyPart::kLeftImageArm: return "left_image_arm";
+    case BodyPart::kRightImageArm: return "right_image_arm";
+    case BodyPart::kArm: return "arm";
+  }
+  return "?";
+}
+
+void BodyPartOptions::Check() const {
+  auto fraction = [](double v, const char* name) {
+    if (!(v > 0 && v <= 1)) throw InputError("", std::string("BodyPartOptions.") + name, "must be in (0, 1]");
+  };
+  if (min_blob_area_px < 1) throw InputError("", "BodyPartOptions.min_blob_area_px", "must be >= 1");
+  fraction(torso_min_width_fraction, "torso_min_width_fraction");
+  fraction(arm_max_width_fraction, "arm_max_width_fraction");
+  fraction(arm_max_height_fraction, "arm_max_height_fraction");
+  fraction(torso_band_fraction, "torso_band_fraction");
+  if (!(link_px > 0)) throw InputError("", "BodyPartOptions.link_px", "must be > 0");
+  if (min_arm_points < 1) throw InputError("", "BodyPartOptions.min_arm_points", "must be >= 1");
+}
+
+std::optional<BodyParts2d> SegmentBodyParts(const cv::Mat& silhouette,
+                                            const AxisGraph& graph,
+                                            const BodyPartOptions& options) {
+  options.Check();
+  if (silhouette.empty() || silhouette.type() != CV_8UC1 || silhouette.cols != graph.width ||
+      silhouette.rows != graph.height) {
+    throw std::invalid_argument("SegmentBodyParts: the silhouette must be CV_8UC1 of the graph's size");
+  }
+  const std::optional<LargestBlob> blob = FindLargestBlob(silhouette, options);
+  if (!blob) return std::nullopt;
+  const int blob_bottom = blob->sil_box.y + blob->bottom;
+  const InscribedCircle circle = TorsoCircle(silhouette, *blob);
+
+  BodyParts2d parts;
+  parts.labels.assign(graph.points.size(), BodyPart::kNone);
+  parts.torso_center_px = Eigen::Vector2d(circle.center.x, circle.center.y);
+  FindTorsoAndHead(graph, HorizontalRunsByRow(graph, *blob), circle, blob_bottom, options, parts);
+  AssignArms(graph, ArmCandidates(graph, *blob, options, parts), options, parts);
   return parts;
 }
 

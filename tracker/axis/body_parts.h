@@ -43,7 +43,7 @@ struct BodyPartOptions {
   // within this many pixels.
   double link_px = 2.0;
   int min_arm_points = 6;  // smaller arm components are dropped
-  void Check() const;      // throws std::invalid_argument
+  void Check() const;      // throws InputError naming the field
 };
 
 struct BodyParts2d {

@@ -1,5 +1,6 @@
 // Body parts (thesis 3.3) on a drawn stick figure with known parts.
 
+#include "common/error.h"
 #include "tracker/axis/body_parts.h"
 
 #include <gtest/gtest.h>
@@ -94,7 +95,7 @@ TEST(BodyPartsTest, NoBlobGivesNothing) {
   EXPECT_FALSE(SegmentBodyParts(empty, ExtractAxisPoints(empty)).has_value());
   BodyPartOptions options;
   options.arm_max_width_fraction = 0;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), InputError);
 }
 
 }  // namespace

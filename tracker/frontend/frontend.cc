@@ -18,7 +18,7 @@ void FrontEndOptions::Check() const {
   voxels.Check();
   polyhedral.Check();
   if (!(placement_max_coverage > 0 && placement_max_coverage <= 1)) {
-    throw std::invalid_argument("front end placement_max_coverage: must be in (0, 1]");
+    throw InputError("", "frontend.placement_max_coverage", "must be in (0, 1]");
   }
 }
 

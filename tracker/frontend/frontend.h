@@ -43,7 +43,7 @@ struct FrontEndOptions {
   // Built on request (irbench track --ply): nothing downstream uses it yet and
   // it is the front end's most expensive stage.
   bool polyhedral_hull = false;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 struct CameraFeatures {

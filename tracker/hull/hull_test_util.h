@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 
 namespace irbench::testing {
 

@@ -30,7 +30,7 @@
 #include <optional>
 #include <vector>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 #include "tracker/hull/polygon.h"
 
 namespace irbench {

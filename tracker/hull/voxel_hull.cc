@@ -92,16 +92,22 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
   nx_ = std::max(1, static_cast<int>(std::ceil(extent.x() / s - 1e-9)));
   ny_ = std::max(1, static_cast<int>(std::ceil(extent.y() / s - 1e-9)));
   nz_ = std::max(1, static_cast<int>(std::ceil(extent.z() / s - 1e-9)));
-  const size_t voxels = size_t(nx_) * ny_ * nz_;
-  const int lx = nx_ + 1, ly = ny_ + 1, lz = nz_ + 1;
-  const size_t lattice = size_t(lx) * ly * lz;
-  const size_t nc = cameras_.size();
-  auto centre_of = [&](size_t v) {
-    const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
-              z = static_cast<int>(v / nx_ / ny_);
-    return Eigen::Vector3d(options_.min_corner_m + s * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5));
-  };
+  // The counts of pass 1 are freed once the candidates are grouped.
+  GroupCandidates(CountObservingCameras());
+  ComputeFootprints();
+  ComputeBounds();
+}
 
+Eigen::Vector3d VoxelCarver::VoxelCentre(size_t v) const {
+  const double s = options_.voxel_size_m;
+  const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
+            z = static_cast<int>(v / nx_ / ny_);
+  return Eigen::Vector3d(options_.min_corner_m + s * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5));
+}
+
+std::vector<uint8_t> VoxelCarver::CountObservingCameras() const {
+  const size_t voxels = size_t(nx_) * ny_ * nz_;
+  const size_t nc = cameras_.size();
   // Pass 1: which voxels enough cameras observe (centre in front and in the image).
   std::vector<uint8_t> observed(voxels, 0);
   for (size_t c = 0; c < nc; ++c) {
@@ -110,7 +116,7 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
       throw InputError("", "cameras[" + std::to_string(c) + "].width", "bad image size");
     }
     for (size_t v = 0; v < voxels; ++v) {
-      const Eigen::Vector3d centre = centre_of(v);
+      const Eigen::Vector3d centre = VoxelCentre(v);
       if ((cam.cam_from_world * centre).z() <= options_.near_m) continue;
       const Eigen::Vector2d pc = cam.Project(centre);
       if (pc.x() >= -0.5 && pc.y() >= -0.5 && pc.x() <= cam.width - 0.5 &&
@@ -118,6 +124,11 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
         ++observed[v];
     }
   }
+  return observed;
+}
+
+void VoxelCarver::GroupCandidates(const std::vector<uint8_t>& observed) {
+  const size_t voxels = size_t(nx_) * ny_ * nz_;
   // The candidates, grouped by block, within it by sub-block and within that
   // by cell (counting sort on the triple; within a cell in voxel index order).
   const int bx = (nx_ + kBlock - 1) / kBlock, by = (ny_ + kBlock - 1) / kBlock,
@@ -162,9 +173,13 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
     if (observed[v] >= options_.min_observing_cameras)
       candidates_[per_block[key_of(v)]++] = static_cast<uint32_t>(v);
   }
-  per_block = {};
-  observed = {};
+}
 
+void VoxelCarver::ComputeFootprints() {
+  const double s = options_.voxel_size_m;
+  const int lx = nx_ + 1, ly = ny_ + 1, lz = nz_ + 1;
+  const size_t lattice = size_t(lx) * ly * lz;
+  const size_t nc = cameras_.size();
   // Pass 2, per camera: the footprint of every candidate, from the projected
   // lattice corners (each shared by up to 8 voxels).
   const size_t nk = candidates_.size();
@@ -201,7 +216,7 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
         ok = ok && lok[corner_index[corner]];
       }
       if (!ok) continue;  // partly behind the camera: no constraint
-      const Eigen::Vector2d pc = cam.Project(centre_of(v));
+      const Eigen::Vector2d pc = cam.Project(VoxelCentre(v));
       double corner_radius = 0;
       for (size_t i : corner_index)
         corner_radius = std::max(corner_radius, std::hypot(lu[i] - pc.x(), lv[i] - pc.y()));
@@ -221,61 +236,66 @@ VoxelCarver::VoxelCarver(std::vector<Camera> cameras, const VoxelGridOptions& op
       f.radius_q = static_cast<uint16_t>(std::min(65535.0, std::floor(radius * 64)));
     }
   }
+}
 
-  // Per block and camera: the bounds. Each voxel's test value is the bilinear
-  // interpolation of D at its point q (pixel + frac / 256), at least the least
-  // and at most the greatest of D at the 4 pixel centres around q, each
-  // within sqrt(2) of q. With all q of the block within rho of a point U and g
-  // the pixel centre nearest U, D being 1-Lipschitz bounds all these values by
-  // D[g] -+ (sqrt(2) + rho + |U - g|). The float arithmetic of the test and
-  // of the transform adds error far below kSlackPx.
+// Per block and camera: the bounds. Each voxel's test value is the bilinear
+// interpolation of D at its point q (pixel + frac / 256), at least the least
+// and at most the greatest of D at the 4 pixel centres around q, each
+// within sqrt(2) of q. With all q of the block within rho of a point U and g
+// the pixel centre nearest U, D being 1-Lipschitz bounds all these values by
+// D[g] -+ (sqrt(2) + rho + |U - g|). The float arithmetic of the test and
+// of the transform adds error far below kSlackPx.
+VoxelCarver::BlockBound VoxelCarver::BoundOf(const Block& block, size_t c) const {
   constexpr double kSlackPx = 0.01;
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  auto bound_of = [&](const Block& block, size_t c) -> BlockBound {
-    const int w = cameras_[c].width, h = cameras_[c].height;
-    double u_lo = 1e30, u_hi = -1e30, v_lo = 1e30, v_hi = -1e30, r_lo = 1e30, r_hi = 0;
-    bool all_constrained = true;
-    for (uint32_t k = block.first; k < block.first + block.count; ++k) {
-      const Footprint& f = footprints_[size_t(k) * nc + c];
-      if (f.pixel < 0) {
-        all_constrained = false;
-        continue;
-      }
-      const double u = f.pixel % w + f.frac_u / 256.0, v = f.pixel / w + f.frac_v / 256.0;
-      u_lo = std::min(u_lo, u);
-      u_hi = std::max(u_hi, u);
-      v_lo = std::min(v_lo, v);
-      v_hi = std::max(v_hi, v);
-      r_lo = std::min(r_lo, f.radius_q / 64.0);
-      r_hi = std::max(r_hi, f.radius_q / 64.0);
+  const size_t nc = cameras_.size();
+  const int w = cameras_[c].width, h = cameras_[c].height;
+  double u_lo = 1e30, u_hi = -1e30, v_lo = 1e30, v_hi = -1e30, r_lo = 1e30, r_hi = 0;
+  bool all_constrained = true;
+  for (uint32_t k = block.first; k < block.first + block.count; ++k) {
+    const Footprint& f = footprints_[size_t(k) * nc + c];
+    if (f.pixel < 0) {
+      all_constrained = false;
+      continue;
     }
-    if (u_lo > u_hi) return {0, kInf, kInf};  // no voxel of the block is constrained: all pass
-    const double cu = 0.5 * (u_lo + u_hi), cv = 0.5 * (v_lo + v_hi);
-    const int gu = std::clamp(static_cast<int>(std::lround(cu)), 0, w - 1),
-              gv = std::clamp(static_cast<int>(std::lround(cv)), 0, h - 1);
-    double rho = 0;
-    for (uint32_t k = block.first; k < block.first + block.count; ++k) {
-      const Footprint& f = footprints_[size_t(k) * nc + c];
-      if (f.pixel < 0) continue;
-      rho = std::max(rho, std::hypot(f.pixel % w + f.frac_u / 256.0 - cu, f.pixel / w + f.frac_v / 256.0 - cv));
-    }
-    const double reach = std::sqrt(2.0) + rho + std::hypot(cu - gu, cv - gv) + kSlackPx;
-    // Voxels without a constraint pass, so only a fully constrained block
-    // can be carved whole.
-    return {gv * w + gu, all_constrained ? static_cast<float>(r_hi + reach) : kInf,
-            static_cast<float>(r_lo - reach)};
-  };
+    const double u = f.pixel % w + f.frac_u / 256.0, v = f.pixel / w + f.frac_v / 256.0;
+    u_lo = std::min(u_lo, u);
+    u_hi = std::max(u_hi, u);
+    v_lo = std::min(v_lo, v);
+    v_hi = std::max(v_hi, v);
+    r_lo = std::min(r_lo, f.radius_q / 64.0);
+    r_hi = std::max(r_hi, f.radius_q / 64.0);
+  }
+  if (u_lo > u_hi) return {0, kInf, kInf};  // no voxel of the block is constrained: all pass
+  const double cu = 0.5 * (u_lo + u_hi), cv = 0.5 * (v_lo + v_hi);
+  const int gu = std::clamp(static_cast<int>(std::lround(cu)), 0, w - 1),
+            gv = std::clamp(static_cast<int>(std::lround(cv)), 0, h - 1);
+  double rho = 0;
+  for (uint32_t k = block.first; k < block.first + block.count; ++k) {
+    const Footprint& f = footprints_[size_t(k) * nc + c];
+    if (f.pixel < 0) continue;
+    rho = std::max(rho, std::hypot(f.pixel % w + f.frac_u / 256.0 - cu, f.pixel / w + f.frac_v / 256.0 - cv));
+  }
+  const double reach = std::sqrt(2.0) + rho + std::hypot(cu - gu, cv - gv) + kSlackPx;
+  // Voxels without a constraint pass, so only a fully constrained block
+  // can be carved whole.
+  return {gv * w + gu, all_constrained ? static_cast<float>(r_hi + reach) : kInf,
+          static_cast<float>(r_lo - reach)};
+}
+
+void VoxelCarver::ComputeBounds() {
+  const size_t nc = cameras_.size();
   bounds_.resize(blocks_.size() * nc);
   for (size_t b = 0; b < blocks_.size(); ++b) {
-    for (size_t c = 0; c < nc; ++c) bounds_[b * nc + c] = bound_of(blocks_[b], c);
+    for (size_t c = 0; c < nc; ++c) bounds_[b * nc + c] = BoundOf(blocks_[b], c);
   }
   sub_bounds_.resize(sub_blocks_.size() * nc);
   for (size_t b = 0; b < sub_blocks_.size(); ++b) {
-    for (size_t c = 0; c < nc; ++c) sub_bounds_[b * nc + c] = bound_of(sub_blocks_[b], c);
+    for (size_t c = 0; c < nc; ++c) sub_bounds_[b * nc + c] = BoundOf(sub_blocks_[b], c);
   }
   cell_bounds_.resize(cells_.size() * nc);
   for (size_t b = 0; b < cells_.size(); ++b) {
-    for (size_t c = 0; c < nc; ++c) cell_bounds_[b * nc + c] = bound_of(cells_[b], c);
+    for (size_t c = 0; c < nc; ++c) cell_bounds_[b * nc + c] = BoundOf(cells_[b], c);
   }
 }
 

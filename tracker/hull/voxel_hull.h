@@ -24,7 +24,7 @@
 #include <optional>
 #include <vector>
 
-#include "sim/camera/camera.h"
+#include "geometry/camera.h"
 
 namespace irbench {
 
@@ -166,6 +166,20 @@ class VoxelCarver {
   };
 
   VoxelHull EmptyHull() const;
+
+  // Constructor steps, in order.
+  // World centre of voxel index v ((z * ny + y) * nx + x), metres.
+  Eigen::Vector3d VoxelCentre(size_t v) const;
+  // Pass 1: per voxel, how many cameras see its centre (in front, in the image).
+  std::vector<uint8_t> CountObservingCameras() const;
+  // Fills candidates_, blocks_, sub_blocks_ and cells_ from the counts of pass 1.
+  void GroupCandidates(const std::vector<uint8_t>& observed);
+  // Pass 2: footprints_, every candidate's footprint in every camera.
+  void ComputeFootprints();
+  // The bound of `block`'s candidates in camera c (from footprints_).
+  BlockBound BoundOf(const Block& block, size_t c) const;
+  // Fills bounds_, sub_bounds_ and cell_bounds_.
+  void ComputeBounds();
 
   std::vector<Camera> cameras_;
   VoxelGridOptions options_;

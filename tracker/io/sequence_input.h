@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/camera/camera.h"
-#include "sim/scene/screen.h"
+#include "geometry/camera.h"
+#include "geometry/screen.h"
 
 namespace irbench {
 

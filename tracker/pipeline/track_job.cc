@@ -96,71 +96,230 @@ const char* Part3dName(BodyPart part) {
   }
 }
 
-}  // namespace
 
-std::string ShadowEdgeScaleProblem(double scale) {
-  constexpr double kMin = 0.25, kMax = 8;
-  if (scale >= kMin && scale <= kMax) return "";
-  char message[64];
-  std::snprintf(message, sizeof(message), "must be in %g..%g", kMin, kMax);
-  return message;
+// The front end's options for this job: the settings' (edge scale applied),
+// the polyhedral hull built when it is written (--ply).
+FrontEndOptions JobFrontEndOptions(const TrackJobOptions& options) {
+  FrontEndOptions fe_options = EffectiveFrontEndOptions(options.tracker);
+  fe_options.polyhedral_hull = options.ply;
+  return fe_options;
 }
 
+// The output must not replace or sit inside what it reads.
+void CheckOutputOutsideSequence(const TrackJobOptions& options) {
+  const fs::path seq = fs::weakly_canonical(fs::absolute(options.sequence));
+  const fs::path out_abs =
+      fs::weakly_canonical(fs::absolute(options.out.empty() ? options.sequence / "track" : options.out));
+  auto inside = [](const fs::path& child, const fs::path& parent) {
+    const auto rel = child.lexically_relative(parent);
+    return !rel.empty() && *rel.begin() != "..";
+  };
+  if (inside(seq, out_abs)) throw InputError("", "--out", "would replace the sequence folder itself");
+  for (const char* part : {"frames", "background", "calib", "truth"}) {
+    if (inside(out_abs, seq / part)) throw InputError("", "--out", std::string("lies inside the sequence's ") + part + "/");
+  }
+}
+
+// The rest-state model (pose stage), loaded before any work is done; null
+// (with a warning) when the default model is absent.
+std::shared_ptr<const RestClassifier> LoadRestClassifier(const TrackerSettings& settings) {
+  if (settings.stage != TrackStage::kPose) return nullptr;
+  const fs::path rest_path = settings.rest_model.empty() ? DefaultRestModelPath() : settings.rest_model;
+  if (!settings.rest_model.empty() || fs::exists(rest_path)) {
+    return std::make_shared<RestClassifier>(RestClassifier::Load(rest_path));
+  }
+  Log().warn("track: no rest-state model at {} (irbench train rest); rest stays null", rest_path.string());
+  return nullptr;
+}
+
+// features.jsonl's per-camera entry: silhouette area, axis points by part,
+// polygon edges, shadow pixels removed, light level, blobs removed.
+nlohmann::json CameraFeaturesJson(const FrameFeatures& features, size_t c) {
+  const CameraFeatures& cf = features.cameras[c];
+  std::map<std::string, int> parts;
+  if (c < features.views.size()) {
+    const AxisView& v = features.views[c];
+    int kept = 0;
+    for (const AxisPoint2d& p : v.graph.points) kept += p.kept;
+    parts["axis_points"] = kept;
+    for (BodyPart b : v.labels) {
+      if (b != BodyPart::kNone) ++parts[BodyPartName(b)];
+    }
+  }
+  nlohmann::json j;
+  j["polygon_edges"] = c < features.polygons.size() ? features.polygons[c].EdgeCount() : 0;
+  j.update({{"silhouette_area", cv::countNonZero(cf.silhouette)},
+            {"axis", parts},
+            {"shadow_pixels_removed", cv::countNonZero(cf.before_shadows & ~cf.silhouette)},
+            {"light_level", cf.light_level},
+            {"blobs_removed", cf.blobs_removed}});
+  return j;
+}
+
+// features.jsonl's hull part: 3D axis points, voxels, placement, polyhedral hull.
+void AddHullFeatures(const FrameFeatures& features, const std::vector<Camera>& cameras, nlohmann::json& line) {
+  nlohmann::json axis3d = nlohmann::json::array();
+  for (const AxisPoint3d& a : features.axis3d) {
+    axis3d.push_back({{"p", Rounded(a.p_in_world)},
+                      {"part", Part3dName(a.part)},
+                      {"diameter_m", std::round(a.diameter_m * 1e4) / 1e4},
+                      {"support", a.support}});
+  }
+  line["axis3d"] = axis3d;
+  if (features.voxels) {
+    line["voxels"] = {{"occupied", features.voxels->occupied_count},
+                      {"volume_m3", std::round(features.voxels->VolumeM3() * 1e5) / 1e5},
+                      {"voxel_size_m", features.voxels->voxel_size_m}};
+  }
+  line["placement"] =
+      features.placement
+          ? nlohmann::json{{"root", Rounded(features.placement->root)},
+                           {"top_m", std::round(features.placement->top_m * 1e3) / 1e3},
+                           {"dropped_view", features.placement->dropped_view < 0
+                                                ? nlohmann::json(nullptr)
+                                                : nlohmann::json(cameras[features.placement->dropped_view].name)},
+                           {"dropped_view_coverage", std::round(features.placement->dropped_view_coverage * 1e3) / 1e3}}
+          : nlohmann::json(nullptr);
+  line["polyhedral_hull"] =
+      features.hull ? nlohmann::json{{"vertices", features.hull->vertices.size()},
+                                     {"triangles", features.hull->triangles.size()},
+                                     {"volume_m3", std::round(MeshVolume(*features.hull) * 1e5) / 1e5}}
+                    : nlohmann::json(nullptr);
+}
+
+// track.jsonl's pointing rays (right, left) with their screen hits.
+nlohmann::json PointingJson(const PoseEstimate& pose) {
+  nlohmann::json pointing = nlohmann::json::object();
+  for (int side = 0; side < 2; ++side) {
+    const auto& ray = pose.pointing[side];
+    nlohmann::json j = nullptr;
+    if (ray) {
+      j = {{"origin", Rounded(ray->origin)}, {"dir", Rounded(ray->dir)}, {"screen", nullptr},
+           {"screen_hit", nullptr}, {"target", nullptr}};
+      if (ray->screen_hit) {
+        j["screen"] = *ray->screen;
+        j["screen_hit"] = {std::round(ray->screen_hit->x() * 1e4) / 1e4, std::round(ray->screen_hit->y() * 1e4) / 1e4};
+        if (ray->target) j["target"] = *ray->target;
+      }
+    }
+    pointing[side == 0 ? "right" : "left"] = j;
+  }
+  return pointing;
+}
+
+// A track.jsonl line (docs/architecture.md, "Tracker output"): what the stages
+// built so far know; everything else null, never invented. Adds the pose's
+// per-camera overlap to the features line.
+nlohmann::json TrackLine(int f, double t, const FrameFeatures& features, const std::optional<PoseEstimate>& pose,
+                         const std::vector<Camera>& cameras, nlohmann::json& line) {
+  nlohmann::json track_line;
+  track_line["frame"] = f;
+  track_line["t"] = t;
+  const bool tracking = pose ? pose->tracking : features.placement.has_value();
+  // "partial": someone is there but not yet (or no longer) in every view.
+  track_line["state"] = tracking ? "tracking" : (pose && features.placement && !pose->in_view) ? "partial" : "empty";
+  nlohmann::json joints = nlohmann::json::object();
+  for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
+                           "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
+                           "left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle"}) {
+    joints[name] = nullptr;
+  }
+  for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
+  track_line["height_m"] = nullptr;
+  if (pose && pose->tracking) {
+    for (int j = 0; j < kModelJointCount; ++j) joints[ModelJointName(j)] = Rounded(pose->body.joints[j]);
+    nlohmann::json dof = nlohmann::json::object();
+    for (int d = 0; d < kDofCount; ++d) dof[BodyDofName(d)] = std::round(pose->pose.dof[d] * 1e5) / 1e5;
+    track_line["dof"] = dof;
+    track_line["pointing"] = PointingJson(*pose);
+    if (pose->rest[0] && pose->rest[1]) track_line["rest"] = {{"right", *pose->rest[0]}, {"left", *pose->rest[1]}};
+    track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
+    track_line["girth"] = std::round(pose->shape.girth * 1e3) / 1e3;
+    track_line["arm_thickness"] = std::round(pose->shape.arm_thickness * 1e3) / 1e3;
+    nlohmann::json overlap = nlohmann::json::object();
+    for (size_t c = 0; c < pose->overlap.size(); ++c) {
+      overlap[cameras[c].name] = std::round(pose->overlap[c] * 1e4) / 1e4;
+    }
+    line["pose_overlap"] = overlap;
+  } else if (!pose && features.placement) {
+    const Eigen::Vector3d& r = features.placement->root;
+    joints["root"] = {std::round(r.x() * 1e4) / 1e4, std::round(r.y() * 1e4) / 1e4, 0.0};
+    track_line["height_m"] = std::round(features.placement->top_m * 1e3) / 1e3;
+  }
+  track_line["joints3d"] = joints;
+  return track_line;
+}
+
+// Milliseconds per stage, for both lines.
+nlohmann::json StageMs(const FrameFeatures& features, const std::optional<PoseEstimate>& pose) {
+  nlohmann::json ms = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes},
+                       {"polygons", features.ms_polygons},       {"voxels", features.ms_voxels},
+                       {"polyhedral_hull", features.ms_polyhedral}};
+  if (pose) {
+    ms["pose"] = pose->ms_total;
+    ms["pose_observation"] = pose->ms_observation;
+    ms["pose_refine"] = pose->ms_refine;
+  }
+  return ms;
+}
+
+// What a track job holds while it runs over the frames.
+struct TrackRun {
+  const TrackJobOptions& options;
+  const SequenceInput& input;
+  const FrontEnd& front_end;
+  std::optional<PoseTracker>& pose_tracker;
+  fs::path root;  // the staging folder
+  std::string lines, track_lines;
+};
+
+// Processes frame f: front end, pose, the silhouettes (and overlays, PLY)
+// written, a line appended to each JSONL.
+void TrackFrame(int f, TrackRun& run) {
+  const TrackJobOptions& options = run.options;
+  const SequenceInput& input = run.input;
+  const std::vector<cv::Mat> images = input.FrameSet(f);
+  const FrameFeatures features = run.front_end.Process(f, images);
+  std::optional<PoseEstimate> pose;
+  if (run.pose_tracker) pose = run.pose_tracker->Step(features, 1.0 / input.fps());
+  nlohmann::json line;
+  line["frame"] = f;
+  line["t"] = f / input.fps();
+  for (size_t c = 0; c < input.cameras().size(); ++c) {
+    const std::string& name = input.cameras()[c].name;
+    line["cameras"][name] = CameraFeaturesJson(features, c);
+    WritePng(run.root / "silhouettes" / name / FrameName(f), features.cameras[c].silhouette);
+    if (options.overlays) {
+      const AxisView* view = c < features.views.size() ? &features.views[c] : nullptr;
+      cv::Mat overlay = Overlay(images[c], features.cameras[c], view, features.axis3d);
+      if (pose && pose->tracking) DrawModel(&overlay, input.cameras()[c], pose->body);
+      WritePng(run.root / "overlays" / name / FrameName(f), overlay);
+    }
+  }
+  AddHullFeatures(features, input.cameras(), line);
+  nlohmann::json track_line = TrackLine(f, f / input.fps(), features, pose, input.cameras(), line);
+  line["ms"] = StageMs(features, pose);
+  if (options.ply) {
+    char stem[32];
+    std::snprintf(stem, sizeof(stem), "%06d", f);
+    if (features.voxels) WriteVoxelCubesPly(run.root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
+    if (features.hull) WriteMeshPly(run.root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
+  }
+  track_line["ms"] = line["ms"];
+  run.lines += line.dump() + "\n";
+  run.track_lines += track_line.dump() + "\n";
+}
+
+}  // namespace
+
 fs::path RunTrackJob(const TrackJobOptions& options) {
-  if (options.stage != "features" && options.stage != "pose") {
-    throw InputError("", "--stage", "'" + options.stage + "': expected features or pose");
-  }
-  if (options.particles < 1) throw InputError("", "--particles", "must be at least 1");
-  FrontEndOptions fe_options;
-  fe_options.background.model = options.background_model;
-  fe_options.remove_shadows = options.remove_shadows;
-  if (const std::string problem = ShadowEdgeScaleProblem(options.shadow_edge_scale); !problem.empty()) {
-    char value[48];
-    std::snprintf(value, sizeof(value), "'%g': ", options.shadow_edge_scale);
-    throw InputError("", "--shadow-edge-scale", value + problem);
-  }
-  fe_options.shadow.canny_low *= options.shadow_edge_scale;
-  fe_options.shadow.canny_high *= options.shadow_edge_scale;
-  try {
-    fe_options.background.Check();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", "--background-model", e.what());
-  }
-  if (options.hull_missing_views < 0 || options.hull_missing_views > 1) {
-    throw InputError("", "--hull-missing-views", "must be 0 or 1");
-  }
-  fe_options.voxels.max_missing_views = options.hull_missing_views;
-  fe_options.polyhedral_hull = options.ply;
-  try {
-    fe_options.Check();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", "track options", e.what());
-  }
-  // The output must not replace or sit inside what it reads.
-  {
-    const fs::path seq = fs::weakly_canonical(fs::absolute(options.sequence));
-    const fs::path out_abs = fs::weakly_canonical(fs::absolute(options.out.empty() ? options.sequence / "track"
-                                                                                    : options.out));
-    auto inside = [](const fs::path& child, const fs::path& parent) {
-      const auto rel = child.lexically_relative(parent);
-      return !rel.empty() && *rel.begin() != "..";
-    };
-    if (inside(seq, out_abs)) throw InputError("", "--out", "would replace the sequence folder itself");
-    for (const char* part : {"frames", "background", "calib", "truth"}) {
-      if (inside(out_abs, seq / part)) throw InputError("", "--out", std::string("lies inside the sequence's ") + part + "/");
-    }
-  }
+  const TrackerSettings& settings = options.tracker;
+  CheckTrackerSettings(settings);
+  const FrontEndOptions fe_options = JobFrontEndOptions(options);
+  fe_options.Check();
+  CheckOutputOutsideSequence(options);
   const SequenceInput input = SequenceInput::Open(options.sequence);
-  // The rest-state model is checked before any work is done.
-  std::shared_ptr<const RestClassifier> rest_classifier;
-  if (options.stage == "pose") {
-    const fs::path rest_path = options.rest_model.empty() ? DefaultRestModelPath() : options.rest_model;
-    if (!options.rest_model.empty() || fs::exists(rest_path)) {
-      rest_classifier = std::make_shared<RestClassifier>(RestClassifier::Load(rest_path));
-    } else {
-      Log().warn("track: no rest-state model at {} (irbench train rest); rest stays null", rest_path.string());
-    }
-  }
+  const std::shared_ptr<const RestClassifier> rest_classifier = LoadRestClassifier(settings);
   int frames = input.frame_count();
   if (options.frames) {
     if (*options.frames < 1) throw InputError("", "--frames", "must be at least 1");
@@ -182,167 +341,29 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
              input.cameras().size(), input.background_count(), train_ms);
 
   std::optional<PoseTracker> pose_tracker;
-  if (options.stage == "pose") {
-    PoseTrackerOptions pose_options;
-    pose_options.particles = options.particles;
-    pose_options.seed = options.seed;
-    pose_tracker.emplace(input.cameras(), input.screens(), pose_options);
+  if (settings.stage == TrackStage::kPose) {
+    pose_tracker.emplace(input.cameras(), input.screens(), settings.pose);
     if (rest_classifier) pose_tracker->set_rest_classifier(rest_classifier);
   }
-  std::string lines, track_lines;
+  TrackRun run{options, input, front_end, pose_tracker, root, "", ""};
   const auto start = std::chrono::steady_clock::now();
   auto last_report = start;
   for (int f = 0; f < frames; ++f) {
     ThrowIfCancelled();
-    const std::vector<cv::Mat> images = input.FrameSet(f);
-    const FrameFeatures features = front_end.Process(f, images);
-    std::optional<PoseEstimate> pose;
-    if (pose_tracker) pose = pose_tracker->Step(features, 1.0 / input.fps());
-    nlohmann::json line;
-    line["frame"] = f;
-    line["t"] = f / input.fps();
-    for (size_t c = 0; c < input.cameras().size(); ++c) {
-      const std::string& name = input.cameras()[c].name;
-      const CameraFeatures& cf = features.cameras[c];
-      std::map<std::string, int> parts;
-      if (c < features.views.size()) {
-        const AxisView& v = features.views[c];
-        int kept = 0;
-        for (const AxisPoint2d& p : v.graph.points) kept += p.kept;
-        parts["axis_points"] = kept;
-        for (BodyPart b : v.labels) {
-          if (b != BodyPart::kNone) ++parts[BodyPartName(b)];
-        }
-      }
-      line["cameras"][name]["polygon_edges"] = c < features.polygons.size() ? features.polygons[c].EdgeCount() : 0;
-      line["cameras"][name].update({{"silhouette_area", cv::countNonZero(cf.silhouette)},
-                               {"axis", parts},
-                               {"shadow_pixels_removed", cv::countNonZero(cf.before_shadows & ~cf.silhouette)},
-                               {"light_level", cf.light_level},
-                               {"blobs_removed", cf.blobs_removed}});
-      WritePng(root / "silhouettes" / name / FrameName(f), cf.silhouette);
-      if (options.overlays) {
-        const AxisView* view = c < features.views.size() ? &features.views[c] : nullptr;
-        cv::Mat overlay = Overlay(images[c], cf, view, features.axis3d);
-        if (pose && pose->tracking) DrawModel(&overlay, input.cameras()[c], pose->body);
-        WritePng(root / "overlays" / name / FrameName(f), overlay);
-      }
-    }
-    nlohmann::json axis3d = nlohmann::json::array();
-    for (const AxisPoint3d& a : features.axis3d) {
-      axis3d.push_back({{"p", Rounded(a.p_in_world)},
-                        {"part", Part3dName(a.part)},
-                        {"diameter_m", std::round(a.diameter_m * 1e4) / 1e4},
-                        {"support", a.support}});
-    }
-    line["axis3d"] = axis3d;
-    if (features.voxels) {
-      line["voxels"] = {{"occupied", features.voxels->occupied_count},
-                        {"volume_m3", std::round(features.voxels->VolumeM3() * 1e5) / 1e5},
-                        {"voxel_size_m", features.voxels->voxel_size_m}};
-    }
-    line["placement"] =
-        features.placement
-            ? nlohmann::json{{"root", Rounded(features.placement->root)},
-                             {"top_m", std::round(features.placement->top_m * 1e3) / 1e3},
-                             {"dropped_view", features.placement->dropped_view < 0
-                                                  ? nlohmann::json(nullptr)
-                                                  : nlohmann::json(input.cameras()[features.placement->dropped_view].name)},
-                             {"dropped_view_coverage", std::round(features.placement->dropped_view_coverage * 1e3) / 1e3}}
-            : nlohmann::json(nullptr);
-    line["polyhedral_hull"] =
-        features.hull ? nlohmann::json{{"vertices", features.hull->vertices.size()},
-                                       {"triangles", features.hull->triangles.size()},
-                                       {"volume_m3", std::round(MeshVolume(*features.hull) * 1e5) / 1e5}}
-                      : nlohmann::json(nullptr);
-    // track.jsonl (docs/formats.md, "Tracker output"): what the stages built
-    // so far know; everything else null, never invented.
-    nlohmann::json track_line;
-    track_line["frame"] = f;
-    track_line["t"] = f / input.fps();
-    const bool tracking = pose ? pose->tracking : features.placement.has_value();
-    // "partial": someone is there but not yet (or no longer) in every view.
-    track_line["state"] = tracking ? "tracking" : (pose && features.placement && !pose->in_view) ? "partial" : "empty";
-    nlohmann::json joints = nlohmann::json::object();
-    for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
-                             "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
-                             "left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle"}) {
-      joints[name] = nullptr;
-    }
-    for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
-    track_line["height_m"] = nullptr;
-    if (pose && pose->tracking) {
-      for (int j = 0; j < kModelJointCount; ++j) joints[ModelJointName(j)] = Rounded(pose->body.joints[j]);
-      nlohmann::json dof = nlohmann::json::object();
-      for (int d = 0; d < kDofCount; ++d) dof[BodyDofName(d)] = std::round(pose->pose.dof[d] * 1e5) / 1e5;
-      track_line["dof"] = dof;
-      nlohmann::json pointing = nlohmann::json::object();
-      for (int side = 0; side < 2; ++side) {
-        const auto& ray = pose->pointing[side];
-        nlohmann::json j = nullptr;
-        if (ray) {
-          j = {{"origin", Rounded(ray->origin)}, {"dir", Rounded(ray->dir)}, {"screen", nullptr},
-               {"screen_hit", nullptr}, {"target", nullptr}};
-          if (ray->screen_hit) {
-            j["screen"] = *ray->screen;
-            j["screen_hit"] = {std::round(ray->screen_hit->x() * 1e4) / 1e4, std::round(ray->screen_hit->y() * 1e4) / 1e4};
-            if (ray->target) j["target"] = *ray->target;
-          }
-        }
-        pointing[side == 0 ? "right" : "left"] = j;
-      }
-      track_line["pointing"] = pointing;
-      if (pose->rest[0] && pose->rest[1]) track_line["rest"] = {{"right", *pose->rest[0]}, {"left", *pose->rest[1]}};
-      track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
-      track_line["girth"] = std::round(pose->shape.girth * 1e3) / 1e3;
-      track_line["arm_thickness"] = std::round(pose->shape.arm_thickness * 1e3) / 1e3;
-      nlohmann::json overlap = nlohmann::json::object();
-      for (size_t c = 0; c < pose->overlap.size(); ++c) {
-        overlap[input.cameras()[c].name] = std::round(pose->overlap[c] * 1e4) / 1e4;
-      }
-      line["pose_overlap"] = overlap;
-    } else if (!pose && features.placement) {
-      const Eigen::Vector3d& r = features.placement->root;
-      joints["root"] = {std::round(r.x() * 1e4) / 1e4, std::round(r.y() * 1e4) / 1e4, 0.0};
-      track_line["height_m"] = std::round(features.placement->top_m * 1e3) / 1e3;
-    }
-    track_line["joints3d"] = joints;
-    line["ms"] = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes},
-                  {"polygons", features.ms_polygons},       {"voxels", features.ms_voxels},
-                  {"polyhedral_hull", features.ms_polyhedral}};
-    if (pose) {
-      line["ms"]["pose"] = pose->ms_total;
-      line["ms"]["pose_observation"] = pose->ms_observation;
-      line["ms"]["pose_refine"] = pose->ms_refine;
-    }
-    if (options.ply) {
-      char stem[32];
-      std::snprintf(stem, sizeof(stem), "%06d", f);
-      if (features.voxels) WriteVoxelCubesPly(root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
-      if (features.hull) WriteMeshPly(root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
-    }
-    track_line["ms"] = line["ms"];
-    lines += line.dump() + "\n";
-    track_lines += track_line.dump() + "\n";
+    TrackFrame(f, run);
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {
       Log().info("track: frame {}/{}", f + 1, frames);
       last_report = now;
     }
   }
-  AtomicWriteFile(root / "features.jsonl", lines);
-  AtomicWriteFile(root / "track.jsonl", track_lines);
-  nlohmann::json meta = {{"format", "irbench.track-features/1"},
-                         {"sequence", fs::absolute(options.sequence).lexically_normal().string()},
-                         {"stage", options.stage},
-                         {"particles", options.particles},
-                         {"seed", options.seed},
-                         {"background_model", options.background_model},
-                         {"remove_shadows", options.remove_shadows},
-                         {"shadow_edge_scale", options.shadow_edge_scale},
-                         {"hull_missing_views", options.hull_missing_views},
-                         {"frames", frames},
-                         {"train_ms", train_ms}};
+  AtomicWriteFile(root / "features.jsonl", run.lines);
+  AtomicWriteFile(root / "track.jsonl", run.track_lines);
+  nlohmann::json meta = SettingsJson(settings);
+  meta.update({{"format", "irbench.track-features/1"},
+               {"sequence", fs::absolute(options.sequence).lexically_normal().string()},
+               {"frames", frames},
+               {"train_ms", train_ms}});
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Log().info("track: {} frame-sets in {:.1f} s ({:.1f} ms per frame-set incl. I/O)", frames, seconds,

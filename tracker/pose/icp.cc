@@ -8,7 +8,8 @@
 #include <optional>
 #include <stdexcept>
 
-#include "tracker/model/ellipse_projection.h"
+#include "tracker/body_model/ellipse_projection.h"
+#include "common/error.h"
 
 namespace irbench {
 namespace {
@@ -124,12 +125,12 @@ Vector3d CombineRotations(const std::vector<Vector3d>& axes, const std::vector<d
 }  // namespace
 
 void IcpOptions::Check() const {
-  if (iterations < 0) throw std::invalid_argument("icp.iterations must be 0 or more");
-  if (points_per_segment < 4) throw std::invalid_argument("icp.points_per_segment must be at least 4");
-  if (!(weight_scale_px > 0)) throw std::invalid_argument("icp.weight_scale_px must be positive");
-  if (!(max_distance_px > 0)) throw std::invalid_argument("icp.max_distance_px must be positive");
+  if (iterations < 0) throw InputError("", "icp.iterations", "must be 0 or more");
+  if (points_per_segment < 4) throw InputError("", "icp.points_per_segment", "must be at least 4");
+  if (!(weight_scale_px > 0)) throw InputError("", "icp.weight_scale_px", "must be positive");
+  if (!(max_distance_px > 0)) throw InputError("", "icp.max_distance_px", "must be positive");
   if (!(max_normal_angle_rad > 0 && max_normal_angle_rad <= M_PI)) {
-    throw std::invalid_argument("icp.max_normal_angle_rad must be in (0, pi]");
+    throw InputError("", "icp.max_normal_angle_rad", "must be in (0, pi]");
   }
 }
 

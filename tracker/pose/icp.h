@@ -25,8 +25,8 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "sim/camera/camera.h"
-#include "tracker/model/body_model.h"
+#include "geometry/camera.h"
+#include "tracker/body_model/body_model.h"
 
 namespace irbench {
 
@@ -40,7 +40,7 @@ struct IcpOptions {
   // thesis's quaternion average (Eq. 6.10), which shrinks each camera's
   // in-plane rotation by the number of cameras.
   bool least_squares = true;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 // One camera's outline: closed polygons in ideal (undistorted) pixels, each

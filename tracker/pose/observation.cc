@@ -8,11 +8,13 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "common/error.h"
+
 namespace irbench {
 
 void ObservationOptions::Check() const {
-  if (!(scale > 0 && scale <= 1)) throw std::invalid_argument("observation.scale must be in (0, 1]");
-  if (!(sharpness > 0)) throw std::invalid_argument("observation.sharpness must be positive");
+  if (!(scale > 0 && scale <= 1)) throw InputError("", "observation.scale", "must be in (0, 1]");
+  if (!(sharpness > 0)) throw InputError("", "observation.sharpness", "must be positive");
 }
 
 void MakeUndistortMaps(const Camera& camera, cv::Mat* map1, cv::Mat* map2) {

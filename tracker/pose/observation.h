@@ -14,9 +14,9 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "sim/camera/camera.h"
-#include "tracker/model/body_model.h"
-#include "tracker/model/ellipse_projection.h"
+#include "geometry/camera.h"
+#include "tracker/body_model/body_model.h"
+#include "tracker/body_model/ellipse_projection.h"
 
 namespace irbench {
 
@@ -25,7 +25,7 @@ struct ObservationOptions {
   double scale = 0.5;
   // Log-likelihood = sharpness * sum over cameras of log(overlap ratio).
   double sharpness = 30.0;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 // One camera's ideal-pinhole silhouette, ready for overlap queries.

@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "common/error.h"
+
 namespace irbench {
 
 std::optional<PointingRay> Pointing(const Eigen::Vector3d& head, const Eigen::Vector3d& hand_tip,
@@ -30,11 +32,11 @@ std::optional<PointingRay> Pointing(const Eigen::Vector3d& head, const Eigen::Ve
 }
 
 void HullHeadOptions::Check() const {
-  if (!(radius_m > 0)) throw std::invalid_argument("pose.hull_head.radius_m must be positive");
-  if (!(slab > 0)) throw std::invalid_argument("pose.hull_head.slab must be positive");
-  if (!(below_top >= 0)) throw std::invalid_argument("pose.hull_head.below_top must be non-negative");
-  if (!(back_m >= 0)) throw std::invalid_argument("pose.hull_head.back_m must be non-negative");
-  if (!(max_gap_m > 0)) throw std::invalid_argument("pose.hull_head.max_gap_m must be positive");
+  if (!(radius_m > 0)) throw InputError("", "pose.hull_head.radius_m", "must be positive");
+  if (!(slab > 0)) throw InputError("", "pose.hull_head.slab", "must be positive");
+  if (!(below_top >= 0)) throw InputError("", "pose.hull_head.below_top", "must be non-negative");
+  if (!(back_m >= 0)) throw InputError("", "pose.hull_head.back_m", "must be non-negative");
+  if (!(max_gap_m > 0)) throw InputError("", "pose.hull_head.max_gap_m", "must be positive");
 }
 
 std::optional<Eigen::Vector3d> HullHeadCentre(const VoxelHull& hull, const Eigen::Vector3d& model_head,

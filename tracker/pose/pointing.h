@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/scene/screen.h"
+#include "geometry/screen.h"
 #include "tracker/hull/voxel_hull.h"
 
 namespace irbench {
@@ -48,7 +48,7 @@ struct HullHeadOptions {
   // the model's crown (the model's head centre plus below_top of the height):
   // a hand over the head, or a head the hull lost.
   double max_gap_m = 0.08;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 // `model_head`: the model's head centre; `forward`: the direction the upper

@@ -5,7 +5,9 @@
 // velocity, the body position from the voxel hull, arm directions from the 3D
 // arm axis points, default poses, and a hook for posture recognition — a
 // 2D-3D ICP refinement of a random subset (icp.h), joint limits and
-// resampling. The best particle gives the joints and the pointing rays.
+// resampling (particle_filter.h). The model is sized to the user as they
+// enter (body_calibration.h, thesis 6.1.2). The best particle gives the
+// joints and the pointing rays.
 //
 // It reads only front-end features (silhouettes, 3D axis points, the voxel
 // hull's placement), the calibration and the surveyed screens: never truth.
@@ -19,121 +21,20 @@
 #include <random>
 #include <vector>
 
-#include "sim/camera/camera.h"
-#include "sim/scene/screen.h"
+#include "geometry/camera.h"
+#include "geometry/screen.h"
 #include "tracker/frontend/frontend.h"
-#include "tracker/model/body_model.h"
+#include "tracker/body_model/body_model.h"
+#include "tracker/pose/arm_points.h"
+#include "tracker/pose/body_calibration.h"
 #include "tracker/pose/icp.h"
 #include "tracker/pose/observation.h"
+#include "tracker/pose/particle_filter.h"  // FlippedPose
 #include "tracker/pose/pointing.h"
+#include "tracker/pose/pose_tracker_options.h"  // PoseTrackerOptions
 #include "tracker/pose/rest_state.h"
 
 namespace irbench {
-
-struct PoseTrackerOptions {
-  int particles = 100;
-  uint64_t seed = 1;
-  ObservationOptions observation;
-  // Proposal choice per particle (thesis 6.3.2), relative weights.
-  double p_random_walk = 0.70;
-  double p_body_position = 0.10;
-  double p_arm_direction = 0.12;
-  double p_default_pose = 0.08;
-  // Share of particles turned half way round with their arms swapped
-  // (FlippedPose), tried before the proposals above.
-  double p_flip = 0.03;
-  // Share of particles turned to another heading with their arms kept
-  // pointing where they point (TurnedPose): half face the screen, half turn
-  // by a random angle. A body stuck side-on after a walk turns back this way;
-  // the random walk's yaw steps are too small to leave that optimum. Not
-  // while the user walks or enters (the walk gives the heading then).
-  double p_turn = 0.04;
-  // Random-walk noise per frame at 30 fps (scaled by sqrt(dt * 30)).
-  double sigma_position_m = 0.02;
-  double sigma_yaw_rad = 0.06;
-  double sigma_torso_rad = 0.03;
-  double sigma_arm_rad = 0.12;
-  // Velocity: the fraction of the last frame's change carried forward, and its
-  // cap per frame (thesis: "a value cap of velocity ... needs to be applied").
-  double velocity_damping = 0.5;
-  double max_step_rad = 0.35;
-  double max_step_m = 0.08;
-  // Above this ground speed of the hull (m/s) the body-position proposal also
-  // turns the body to face where it walks.
-  double walking_speed_mps = 0.5;
-  // Heading priors, added to the log-likelihood as -w * (1 - cos(d)) / 2 for a
-  // heading d away from the preferred one: people face where they walk, and
-  // otherwise mostly face the screen. They only decide between hypotheses the
-  // silhouettes cannot tell apart (front and back look alike).
-  double walking_heading_prior = 5.0;
-  double screen_heading_prior = 4.0;
-  // After a walk, people keep facing about where they walked while they turn
-  // to the screen: for this long the preferred heading blends from the last
-  // walking direction to the screen's (linearly). A user first seen half in
-  // view is entering, heading for the stage's centre: the same memory.
-  double walk_memory_s = 2.0;
-  // The waist rises at most this far above its standing height (the shape's
-  // waist_height_m): the feet stay on the floor. Left free, the filter
-  // lifted tall bodies 3-5 cm to fit their silhouettes, raising the head
-  // that pointing rays start from. Crouching and bowing lower it freely.
-  double max_rise_m = 0.02;
-  // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
-  double refine_fraction = 0.2;
-  IcpOptions icp;
-  // Rest state (thesis 6.4): besides the SVM's vote, an arm the 3D axis
-  // points show apart from the body is at rest when the direction from the
-  // shoulder to their farthest point is within this of straight down. (The
-  // truth's rule: upper arm within 30 deg and forearm within 45 of the
-  // chest's down axis. Straight down stands in for the chest's axis, which
-  // the tracked torso gives only to a few degrees: against it, seeds 1-5 of
-  // the five demos made 251 errors in 25568 arm-frames, against straight
-  // down 220, both before rest_lifted_memory_s. A user bowing deeply with
-  // hanging arms is taken for at rest.)
-  double rest_seen_max_angle_deg = 34;
-  // An arm they do not show is at rest when forcing it down (to the best of
-  // six hanging poses, which the estimate then shows) costs less than this
-  // in the sum over cameras of log overlap ratio: the silhouettes cannot
-  // tell that arm from a hanging one ("when the arms ... are wrapped near
-  // the body, the silhouettes are visually nearly undistinguishable"). The
-  // SVM, trained on exact joints, takes a hanging arm the filter has put at
-  // the torso's side or behind it for a raised one. 0 turns the test off.
-  double rest_max_log_overlap_loss = 0.27;
-  // ... unless the axis points showed it lifted at least rest_lifted_angle_deg
-  // from straight down within the last rest_lifted_memory_s: an arm does not
-  // drop from there to the side unseen so fast; it has left the silhouettes
-  // (noise, an arm overhead against the head). On p1_demo_harsh, seeds 1-3,
-  // it cuts the arm-frames of a raised arm taken for hanging from 143 to 45.
-  double rest_lifted_angle_deg = 45;
-  double rest_lifted_memory_s = 0.5;
-  // The head joint, and so the pointing rays' origin, measured on the voxel
-  // hull (HullHeadCentre) where every camera's silhouette holds the model's
-  // head centre and the hull shows a head near it; the model's head
-  // otherwise. Five demos, seeds 1-3: pointing 2.27 -> 1.91 deg (p2 3.07 ->
-  // 2.18).
-  bool head_from_hull = true;
-  HullHeadOptions hull_head;
-  // Tracking is declared when the voxel hull sees a person and the best
-  // particle's mean overlap ratio reaches this.
-  double min_overlap = 0.35;
-  // "In view": a box of this half-width about the hull's root, from the floor
-  // to the body's height, projects inside every camera's image.
-  double view_margin_m = 0.35;
-  // Frames over which the height and girth are estimated after a user
-  // enters (medians of per-frame values, while the arms are below the
-  // shoulders).
-  int height_frames = 15;
-  // Arm thickness (BodyShape::arm_thickness) from the 3D arm axis points'
-  // diameters: their median over the first arm_thickness_frames tracked
-  // frames that have arm points (0 turns the measurement off), once
-  // arm_thickness_min_points are in, over arm_reference_diameter (a fraction
-  // of the height) times the height; at least 1 (the model's arms are sized
-  // for bare or tight sleeves), at most max_arm_thickness.
-  int arm_thickness_frames = 150;
-  int arm_thickness_min_points = 300;
-  double arm_reference_diameter = 0.055;
-  double max_arm_thickness = 1.3;
-  void Check() const;  // throws std::invalid_argument
-};
 
 struct PoseEstimate {
   // A person fully in view whose pose the filter explains; false on an empty
@@ -156,13 +57,6 @@ struct PoseEstimate {
 // Descriptor & Posture Recognition Function"): poses to seed particles with.
 using PoseProposalHook = std::function<std::vector<BodyPose>(const FrameFeatures&, const BodyShape&)>;
 
-// The front/back twin of `pose`: turned by pi about z through the waist
-// joint, the arms swapped and mirrored, so that its silhouettes are nearly
-// those of `pose`: the arms land exactly where they were, the trunk and head
-// (spine_depth_m ahead of the spine) move by twice that, a few centimetres
-// the filter's next steps take up.
-BodyPose FlippedPose(const BodyPose& pose);
-
 class PoseTracker {
  public:
   // `screens` (as surveyed, calib/screens.json) give the pointing targets
@@ -183,15 +77,45 @@ class PoseTracker {
   const std::vector<BodyPose>& particles() const { return particles_; }
 
  private:
+  // Step's parts, in the order it takes them (pose_tracker.cc).
+  // The frame's silhouettes as overlap views and, when ICP refines, outlines.
+  void MakeViews(const FrameFeatures& features, std::vector<SilhouetteView>* views,
+                 std::vector<IcpView>* icp_views) const;
+  // The hull's ground velocity, walking_, the walk's memory and entering_
+  // from the hull's root `root_xy` (world, metres) `dt` seconds on.
+  void UpdateWalking(const Eigen::Vector2d& root_xy, double dt);
+  // Reads the 3D axis points for the proposals (arm_chains_, torso_xy_);
+  // returns this frame's arm diameters (metres).
+  std::vector<double> ReadAxisPoints(const FrameFeatures& features);
+  // A new user: the model sized to the hull (body_calibration.h) and the
+  // particles seeded at its root.
   void Initialise(const FrameFeatures& features);
-  BodyPose Propose(const BodyPose& current, const BodyPose& previous, const FrameFeatures& features, double dt);
-  BodyPose ArmDirectionProposal(BodyPose pose, const FrameFeatures& features);
-  BodyPose DefaultPoseProposal(const BodyPose& current, const FrameFeatures& features);
-  BodyPose TurnedPose(const BodyPose& current, double yaw) const;
-  // The waist at most max_rise_m above its standing height.
-  void CapRise(BodyPose* pose) const;
-  // The model for a height and girth, its arms as thick as measured.
-  BodyShape ShapeFor(double height_m, double girth) const;
+  // Thesis 6.3.2: this frame's proposed particles (the first frame's seeds
+  // on acquiring a user), the hook's proposals replacing the last ones.
+  std::vector<BodyPose> ProposeParticles(const FrameFeatures& features, double dt);
+  // The best particle as the estimate: pose, overlaps, in view, tracking.
+  // Returns whether it explains the silhouettes (min_overlap).
+  bool EstimateFromBest(const std::vector<BodyPose>& proposed, int best, const FrameFeatures& features,
+                        const std::vector<SilhouetteView>& views, PoseEstimate* out) const;
+  // Thesis 6.1.2: the height, girth and arm thickness measured on the
+  // estimate; the particles and the estimate rescaled with the model.
+  void Calibrate(const FrameFeatures& features, const std::vector<SilhouetteView>& views,
+                 const std::vector<double>& arm_diameters, std::vector<BodyPose>* proposed, PoseEstimate* out);
+  // Thesis 6.4: each arm's rest state; an arm at rest is forced down.
+  void DecideRest(const std::vector<BodyPose>& proposed, const std::vector<double>& log_likelihood, int best,
+                  const std::vector<SilhouetteView>& views, double dt, PoseEstimate* out);
+  // The rest classifier's vote on one arm, by the voters' weights.
+  bool RestVote(const std::vector<std::optional<PosedBody>>& voters, const std::vector<double>& vote_weight,
+                bool left) const;
+  // `pose` with one arm hanging as the silhouettes like best; its
+  // log-likelihood in `ll`.
+  BodyPose HangingArmPose(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
+                          double* ll) const;
+  // The head from the hull (pointing.h) and the pointing rays of the arms
+  // not at rest.
+  void HeadAndPointing(const FrameFeatures& features, const std::vector<SilhouetteView>& views,
+                       PoseEstimate* out) const;
+
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
   double HeadingPrior(const BodyPose& pose) const;
   bool InView(const Eigen::Vector3d& root) const;
@@ -214,19 +138,10 @@ class PoseTracker {
 
   bool active_ = false;
   BodyShape shape_;
-  std::vector<double> heights_, girths_;
-  std::vector<double> arm_diameters_;  // metres, from the 3D arm axis points
-  int arm_frames_ = 0;                 // tracked frames that gave them
-  double arm_diameter_m_ = 0;          // their median; 0 until measured
+  BodyCalibration calibration_;  // the user's height, girth and arm thickness
   std::vector<BodyPose> particles_, previous_;
   std::deque<Eigen::Vector2d> recent_roots_;
   // This frame's 3D arm axis points in chains, and torso axis points (x, y).
-  struct ArmChains {
-    std::vector<Eigen::Vector3d> points;
-    std::vector<int> chain;  // per point
-    int count = 0;
-  };
-  static ArmChains ChainArmPoints(const std::vector<AxisPoint3d>& axis3d, double link_m = 0.08);
   ArmChains arm_chains_;
   std::vector<Eigen::Vector2d> torso_xy_;
   Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();

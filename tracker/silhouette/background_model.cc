@@ -1,12 +1,14 @@
 #include "tracker/silhouette/background_model.h"
 
 #include "tracker/silhouette/internal/box.h"
+#include "common/error.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <tuple>
 
 namespace irbench {
 namespace {
@@ -121,37 +123,87 @@ float ValueOfRank(std::vector<float>& v, size_t k) {
   return v[k];
 }
 
+std::optional<BackgroundKind> ParseBackgroundKind(const std::string& name) {
+  if (name == "flicker") return BackgroundKind::kFlicker;
+  if (name == "plain") return BackgroundKind::kPlain;
+  return std::nullopt;
+}
+
+const char* BackgroundKindName(BackgroundKind kind) { return kind == BackgroundKind::kPlain ? "plain" : "flicker"; }
+
 void BackgroundOptions::Check() const {
-  if (model != "flicker" && model != "plain") {
-    throw std::invalid_argument("background model: must be flicker or plain, not '" + model + "'");
-  }
-  if (!(threshold_sigma > 0)) throw std::invalid_argument("background threshold_sigma: must be > 0");
+  if (!(threshold_sigma > 0)) throw InputError("", "background.threshold_sigma", "must be > 0");
   if (!(pool_sigma >= 0 && pool_threshold > 0)) {
-    throw std::invalid_argument("background pool_sigma: must be >= 0, pool_threshold > 0");
+    throw InputError("", "background.pool_sigma", "must be >= 0, pool_threshold > 0");
   }
   if (!(pool_weak_threshold > 0 && pool_weak_threshold <= pool_threshold)) {
-    throw std::invalid_argument("background pool_weak_threshold: must be in (0, pool_threshold]");
+    throw InputError("", "background.pool_weak_threshold", "must be in (0, pool_threshold]");
   }
   // sigma 0 (a saturated or constant pixel) would make the normalised difference infinite.
-  if (!(min_sigma > 0)) throw std::invalid_argument("background min_sigma: must be > 0");
+  if (!(min_sigma > 0)) throw InputError("", "background.min_sigma", "must be > 0");
   if (!(slope_sigma >= 0 && slope_sigma <= 32)) {
-    throw std::invalid_argument("background slope_sigma: must be in [0, 32] (0: no smoothing)");
+    throw InputError("", "background.slope_sigma", "must be in [0, 32] (0: no smoothing)");
   }
-  if (open_radius < 0 || close_radius < 0) throw std::invalid_argument("background morphology radii: must be >= 0");
+  if (open_radius < 0 || close_radius < 0) throw InputError("", "background.morphology_radii", "must be >= 0");
   if (!(min_blob_fraction >= 0 && min_blob_fraction < 1)) {
-    throw std::invalid_argument("background min_blob_fraction: must be in [0, 1)");
+    throw InputError("", "background.min_blob_fraction", "must be in [0, 1)");
   }
-  if (!(near_blob_px >= 0)) throw std::invalid_argument("background near_blob_px: must be non-negative");
+  if (!(near_blob_px >= 0)) throw InputError("", "background.near_blob_px", "must be non-negative");
   if (!(near_blob_min_fraction >= 0 && near_blob_min_fraction < 1)) {
-    throw std::invalid_argument("background near_blob_min_fraction: must be in [0, 1)");
+    throw InputError("", "background.near_blob_min_fraction", "must be in [0, 1)");
   }
   if (!(outline_sigma >= 0 && outline_sigma <= 8)) {
-    throw std::invalid_argument("background outline_sigma: must be in [0, 8] (0: no outline refinement)");
+    throw InputError("", "background.outline_sigma", "must be in [0, 8] (0: no outline refinement)");
   }
-  if (outline_band < 0 || outline_band > 8) throw std::invalid_argument("background outline_band: must be in [0, 8]");
-  if (!(outline_min_laplacian >= 0)) throw std::invalid_argument("background outline_min_laplacian: must be >= 0");
-  if (!(outline_doubt >= 0)) throw std::invalid_argument("background outline_doubt: must be >= 0");
-  if (!(outline_max_hole >= 0)) throw std::invalid_argument("background outline_max_hole: must be >= 0");
+  if (outline_band < 0 || outline_band > 8) throw InputError("", "background.outline_band", "must be in [0, 8]");
+  if (!(outline_min_laplacian >= 0)) throw InputError("", "background.outline_min_laplacian", "must be >= 0");
+  if (!(outline_doubt >= 0)) throw InputError("", "background.outline_doubt", "must be >= 0");
+  if (!(outline_max_hole >= 0)) throw InputError("", "background.outline_max_hole", "must be >= 0");
+}
+
+// The training frames and what every step of Train reads of them.
+struct BackgroundModel::TrainingSet {
+  // Computes the statistics of `frames` (CV_8UC1, one size, at least one).
+  TrainingSet(const std::vector<cv::Mat>& training_frames, const BackgroundOptions& options, const cv::Mat& screen);
+
+  const std::vector<cv::Mat>& frames;
+  int n = 0;
+  cv::Size size;
+  bool flicker = false;  // the flicker model
+  // Screen pixels follow the projection, not L: they take no part in L (the
+  // mean of the other pixels) and are modelled on the screen's own level.
+  bool own_screen = false;
+  cv::Mat stage;               // CV_8U, 255 off the screens with own_screen; else empty (every pixel)
+  std::vector<double> light;   // L per frame: the mean grey level over `stage`
+  double light_mean = 0, light_var = 0;
+  std::vector<cv::Mat> f64;    // the frames, CV_64F
+  cv::Mat sum_l;               // Σ I·(L − L̄) per pixel, CV_64F
+  cv::Mat mean;                // μ per pixel, CV_64F
+  // The slopes' smoothing (Gaussian sigma, px), and what it leaves of their noise.
+  double slope_px = 0;
+  double se_scale = 1;
+};
+
+BackgroundModel::TrainingSet::TrainingSet(const std::vector<cv::Mat>& training_frames,
+                                          const BackgroundOptions& options, const cv::Mat& screen)
+    : frames(training_frames), n(static_cast<int>(training_frames.size())), size(training_frames[0].size()) {
+  own_screen = options.model == BackgroundKind::kFlicker && !screen.empty() && cv::countNonZero(screen) >= 50;
+  stage = own_screen ? cv::Mat(screen == 0) : cv::Mat();
+  light.assign(n, 0.0);
+  for (int i = 0; i < n; ++i) light[i] = cv::mean(frames[i], stage)[0];
+  std::tie(light_mean, light_var) = MeanAndVariance(light);
+  f64.resize(n);
+  for (int i = 0; i < n; ++i) frames[i].convertTo(f64[i], CV_64F);
+  cv::Mat sum = cv::Mat::zeros(size, CV_64F);
+  sum_l = cv::Mat::zeros(size, CV_64F);
+  for (int i = 0; i < n; ++i) {
+    sum += f64[i];
+    sum_l += f64[i] * (light[i] - light_mean);
+  }
+  mean = sum / n;
+  flicker = options.model == BackgroundKind::kFlicker;
+  slope_px = options.slope_sigma * size.width / 320.0;
+  se_scale = slope_px > 0 ? GaussianNorm(slope_px, false) : 1.0;
 }
 
 std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>& frames,
@@ -163,203 +215,203 @@ std::optional<BackgroundModel> BackgroundModel::Train(const std::vector<cv::Mat>
   for (const cv::Mat& f : frames) {
     if (f.size() != size || f.type() != CV_8UC1) return std::nullopt;
   }
-  const int n = static_cast<int>(frames.size());
-  // Screen pixels follow the projection, not L: they take no part in L (the
-  // mean of the other pixels) and are modelled on the screen's own level.
-  const bool own_screen = options.model == "flicker" && !screen.empty() && cv::countNonZero(screen) >= 50;
-  const cv::Mat stage = own_screen ? cv::Mat(screen == 0) : cv::Mat();
-  std::vector<double> light(n);
-  for (int i = 0; i < n; ++i) light[i] = cv::mean(frames[i], stage)[0];
-  const auto [light_mean, light_var] = MeanAndVariance(light);
-  std::vector<cv::Mat> f64(n);
-  for (int i = 0; i < n; ++i) frames[i].convertTo(f64[i], CV_64F);
+  const TrainingSet set(frames, options, screen);
 
   BackgroundModel m;
   m.options_ = options;
-  m.mean_light_ = light_mean;
-  cv::Mat sum = cv::Mat::zeros(size, CV_64F), sum_l = cv::Mat::zeros(size, CV_64F);
-  for (int i = 0; i < n; ++i) {
-    sum += f64[i];
-    sum_l += f64[i] * (light[i] - light_mean);
-  }
-  const cv::Mat mean = sum / n;
+  m.mean_light_ = set.light_mean;
   // With (almost) no light change in training, b is not identifiable: plain.
-  const bool flicker = options.model == "flicker";
-  bool regress = flicker && light_var > 0.05 && n >= 3;
-  // Fits a, b and sigma per pixel and picks the pixels the light is read from
-  // (those that follow it clearly: b well above its noise). A regression whose
-  // slopes too few pixels show significantly (a light change in training too
-  // small for the noise) falls back to pixels scaling with the light: the
-  // whole stage still brightens with a flash, and L must follow it.
+  bool regress = set.flicker && set.light_var > 0.05 && set.n >= 3;
+  // A regression whose slopes too few pixels show significantly (a light
+  // change in training too small for the noise) falls back to pixels scaling
+  // with the light: the whole stage still brightens with a flash, and L must
+  // follow it.
   cv::Mat light_pixels;  // CV_8U: pixels whose b is large enough to read L from
-  // The slopes' smoothing, and what it leaves of their noise.
-  const double slope_px = options.slope_sigma * size.width / 320.0;
-  const double se_scale = slope_px > 0 ? GaussianNorm(slope_px, false) : 1.0;
-  const auto fit = [&](bool by_regression) {
-    cv::Mat b = Slopes(by_regression, flicker, sum_l, n, light_var, mean, light_mean);
-    if (by_regression && slope_px > 0) {
-      // Over the stage's pixels only: the screens' slopes are another light's.
-      if (stage.empty()) {
-        cv::GaussianBlur(b, b, cv::Size(), slope_px);
-      } else {
-        cv::Mat weight, weighted;
-        stage.convertTo(weight, CV_64F, 1.0 / 255);
-        cv::GaussianBlur(b.mul(weight), weighted, cv::Size(), slope_px);
-        cv::GaussianBlur(weight, weight, cv::Size(), slope_px);
-        b = weighted / cv::max(weight, 1e-6);
-      }
-    }
-    const int dof = std::max(1, n - (by_regression ? 2 : 1));
-    const PixelLines lines = FitLines(f64, light, light_mean, mean, b, dof, options.min_sigma);
-    lines.a.convertTo(m.a_, CV_32F);
-    lines.b.convertTo(m.b_, CV_32F);
-    lines.sigma.convertTo(m.sigma_, CV_32F);
-    light_pixels = cv::Mat::zeros(size, CV_8U);
-    if (flicker && !by_regression) light_pixels = m.b_ > 0.2;
-    if (by_regression) {
-      for (int y = 0; y < size.height; ++y) {
-        const float* bp = m.b_.ptr<float>(y);
-        const float* sp = m.sigma_.ptr<float>(y);
-        uint8_t* lp = light_pixels.ptr<uint8_t>(y);
-        for (int x = 0; x < size.width; ++x) {
-          // b's standard error is σ / (sqrt(n) · std(L)), times the
-          // smoothing kernel's norm.
-          lp[x] = bp[x] > 0.2 && bp[x] > 3 * se_scale * sp[x] / std::sqrt(n * light_var) ? 255 : 0;
-        }
-      }
-    }
-    if (!m.screen_.empty()) light_pixels.setTo(0, m.screen_);
-    return dof;
-  };
-  if (own_screen) m.screen_ = screen.clone();
-  int dof = fit(regress);
+  if (set.own_screen) m.screen_ = screen.clone();
+  int dof = m.FitLight(set, regress, light_pixels);
   if (regress && cv::countNonZero(light_pixels) < kMinLightPixels) {
     regress = false;
-    dof = fit(false);
+    dof = m.FitLight(set, false, light_pixels);
   }
-  // The screen pixels: the same model on the screen's own level G (the mean
-  // of its pixels; see the header), fitted over the training frames where G
-  // changes (a calibration sweep), else each pixel scales with it; so too
-  // when the regression leaves too few pixels to read G from (a change in
-  // training too small for the noise).
-  std::vector<double> screen_level(n, 0.0);
-  if (!m.screen_.empty()) {
-    for (int i = 0; i < n; ++i) screen_level[i] = cv::mean(frames[i], m.screen_)[0];
-    const auto [g_mean, g_var] = MeanAndVariance(screen_level);
-    m.mean_screen_ = g_mean;
-    cv::Mat sum_g = cv::Mat::zeros(size, CV_64F);
-    for (int i = 0; i < n; ++i) sum_g += f64[i] * (screen_level[i] - g_mean);
-    const auto fit_screen = [&](bool by_regression) {
-      const cv::Mat b = Slopes(by_regression, true, sum_g, n, g_var, mean, g_mean);
-      const PixelLines lines =
-          FitLines(f64, screen_level, g_mean, mean, b, std::max(1, n - (by_regression ? 2 : 1)), options.min_sigma);
-      cv::Mat a32, b32, s32;
-      lines.a.convertTo(a32, CV_32F);
-      lines.b.convertTo(b32, CV_32F);
-      lines.sigma.convertTo(s32, CV_32F);
-      a32.copyTo(m.a_, m.screen_);
-      b32.copyTo(m.b_, m.screen_);
-      s32.copyTo(m.sigma_, m.screen_);
-      // G is read from the pixels that follow it clearly (every other row
-      // and column): b well above its standard error, or without the
-      // regression, a pixel bright enough to scale.
-      m.screen_samples_.clear();
-      m.screen_a_.clear();
-      m.screen_b_.clear();
-      for (int y = 0; y < size.height; y += 2) {
-        const uint8_t* sp = m.screen_.ptr<uint8_t>(y);
-        const float* bp = m.b_.ptr<float>(y);
-        const float* gp = m.sigma_.ptr<float>(y);
-        const double* mp = mean.ptr<double>(y);
-        for (int x = 0; x < size.width; x += 2) {
-          if (!sp[x] || !(bp[x] > 0.2)) continue;
-          if (by_regression ? bp[x] <= 3 * gp[x] / std::sqrt(n * g_var) : mp[x] <= 4) continue;
-          m.screen_samples_.push_back({y, x});
-          m.screen_a_.push_back(m.a_.ptr<float>(y)[x]);
-          m.screen_b_.push_back(bp[x]);
-        }
-      }
-      return m.screen_samples_.size() >= kMinScreenSamples;
-    };
-    const bool screen_regress = g_var > 0.05 && n >= 3 && fit_screen(true);
-    if (!screen_regress) {
-      fit_screen(false);
-      std::fill(screen_level.begin(), screen_level.end(), -1.0);  // read from the frames
+  std::vector<double> screen_level(set.n, 0.0);
+  if (!m.screen_.empty()) m.FitScreen(set, screen_level);
+  m.light_pixel_count_ = cv::countNonZero(light_pixels);
+  m.SampleLightPixels(light_pixels);
+  m.MeasureTrainingNoise(set, regress, dof, screen_level);
+  return m;
+}
+
+int BackgroundModel::FitLight(const TrainingSet& set, bool by_regression, cv::Mat& light_pixels) {
+  const int n = set.n;
+  const cv::Size size = set.size;
+  cv::Mat b = Slopes(by_regression, set.flicker, set.sum_l, n, set.light_var, set.mean, set.light_mean);
+  if (by_regression && set.slope_px > 0) {
+    // Over the stage's pixels only: the screens' slopes are another light's.
+    if (set.stage.empty()) {
+      cv::GaussianBlur(b, b, cv::Size(), set.slope_px);
+    } else {
+      cv::Mat weight, weighted;
+      set.stage.convertTo(weight, CV_64F, 1.0 / 255);
+      cv::GaussianBlur(b.mul(weight), weighted, cv::Size(), set.slope_px);
+      cv::GaussianBlur(weight, weight, cv::Size(), set.slope_px);
+      b = weighted / cv::max(weight, 1e-6);
     }
   }
-  m.light_pixel_count_ = cv::countNonZero(light_pixels);
+  const int dof = std::max(1, n - (by_regression ? 2 : 1));
+  const PixelLines lines = FitLines(set.f64, set.light, set.light_mean, set.mean, b, dof, options_.min_sigma);
+  lines.a.convertTo(a_, CV_32F);
+  lines.b.convertTo(b_, CV_32F);
+  lines.sigma.convertTo(sigma_, CV_32F);
+  light_pixels = cv::Mat::zeros(size, CV_8U);
+  if (set.flicker && !by_regression) light_pixels = b_ > 0.2;
+  if (by_regression) {
+    for (int y = 0; y < size.height; ++y) {
+      const float* bp = b_.ptr<float>(y);
+      const float* sp = sigma_.ptr<float>(y);
+      uint8_t* lp = light_pixels.ptr<uint8_t>(y);
+      for (int x = 0; x < size.width; ++x) {
+        // b's standard error is σ / (sqrt(n) · std(L)), times the
+        // smoothing kernel's norm.
+        lp[x] = bp[x] > 0.2 && bp[x] > 3 * set.se_scale * sp[x] / std::sqrt(n * set.light_var) ? 255 : 0;
+      }
+    }
+  }
+  if (!screen_.empty()) light_pixels.setTo(0, screen_);
+  return dof;
+}
+
+void BackgroundModel::FitScreen(const TrainingSet& set, std::vector<double>& screen_level) {
+  const int n = set.n;
+  for (int i = 0; i < n; ++i) screen_level[i] = cv::mean(set.frames[i], screen_)[0];
+  const auto [g_mean, g_var] = MeanAndVariance(screen_level);
+  mean_screen_ = g_mean;
+  cv::Mat sum_g = cv::Mat::zeros(set.size, CV_64F);
+  for (int i = 0; i < n; ++i) sum_g += set.f64[i] * (screen_level[i] - g_mean);
+  const bool screen_regress =
+      g_var > 0.05 && n >= 3 && FitScreenLines(set, screen_level, g_mean, g_var, sum_g, true);
+  if (!screen_regress) {
+    FitScreenLines(set, screen_level, g_mean, g_var, sum_g, false);
+    std::fill(screen_level.begin(), screen_level.end(), -1.0);  // read from the frames
+  }
+}
+
+bool BackgroundModel::FitScreenLines(const TrainingSet& set,
+                                     const std::vector<double>& screen_level,
+                                     double g_mean,
+                                     double g_var,
+                                     const cv::Mat& sum_g,
+                                     bool by_regression) {
+  const int n = set.n;
+  const cv::Size size = set.size;
+  const cv::Mat b = Slopes(by_regression, true, sum_g, n, g_var, set.mean, g_mean);
+  const PixelLines lines = FitLines(set.f64, screen_level, g_mean, set.mean, b,
+                                    std::max(1, n - (by_regression ? 2 : 1)), options_.min_sigma);
+  cv::Mat a32, b32, s32;
+  lines.a.convertTo(a32, CV_32F);
+  lines.b.convertTo(b32, CV_32F);
+  lines.sigma.convertTo(s32, CV_32F);
+  a32.copyTo(a_, screen_);
+  b32.copyTo(b_, screen_);
+  s32.copyTo(sigma_, screen_);
+  // G is read from the pixels that follow it clearly (every other row
+  // and column): b well above its standard error, or without the
+  // regression, a pixel bright enough to scale.
+  screen_samples_.clear();
+  screen_a_.clear();
+  screen_b_.clear();
+  for (int y = 0; y < size.height; y += 2) {
+    const uint8_t* sp = screen_.ptr<uint8_t>(y);
+    const float* bp = b_.ptr<float>(y);
+    const float* gp = sigma_.ptr<float>(y);
+    const double* mp = set.mean.ptr<double>(y);
+    for (int x = 0; x < size.width; x += 2) {
+      if (!sp[x] || !(bp[x] > 0.2)) continue;
+      if (by_regression ? bp[x] <= 3 * gp[x] / std::sqrt(n * g_var) : mp[x] <= 4) continue;
+      screen_samples_.push_back({y, x});
+      screen_a_.push_back(a_.ptr<float>(y)[x]);
+      screen_b_.push_back(bp[x]);
+    }
+  }
+  return screen_samples_.size() >= kMinScreenSamples;
+}
+
+void BackgroundModel::SampleLightPixels(const cv::Mat& light_pixels) {
   // The light is read from every other row and column: a quarter of the
   // pixels is plenty for a median.
-  for (int y = 0; y < size.height; y += 2) {
+  for (int y = 0; y < light_pixels.rows; y += 2) {
     const uint8_t* lp = light_pixels.ptr<uint8_t>(y);
-    for (int x = 0; x < size.width; x += 2) {
+    for (int x = 0; x < light_pixels.cols; x += 2) {
       if (lp[x]) {
-        m.light_samples_.push_back({y, x});
-        m.light_a_.push_back(m.a_.ptr<float>(y)[x]);
-        m.light_b_.push_back(m.b_.ptr<float>(y)[x]);
+        light_samples_.push_back({y, x});
+        light_a_.push_back(a_.ptr<float>(y)[x]);
+        light_b_.push_back(b_.ptr<float>(y)[x]);
       }
     }
   }
-  // The noises the thresholds are set in, measured on the training frames:
-  // the pooled z's, and the outline refinement's (the difference I − μ(t)
-  // in grey levels smoothed by its Gaussian, and that smoothed difference's
-  // Laplacian), each one figure for the whole image.
-  const bool pool = flicker && options.pool_sigma > 0, outline = flicker && options.outline_sigma > 0;
-  if (pool || outline) {
-    double pooled_sq = 0, smooth_sq = 0, laplacian_sq = 0;
-    size_t count = 0;
-    // With the light regressed, on the half of the frames whose light is
-    // nearest the mean: the ends of a calibration sweep hold the smoothed
-    // slopes' error times a light change several times a sequence's (its
-    // content stays within ±10% of the sweep's middle, flashes aside), and
-    // set in it the thresholds rose (closed loop 0.877 against 0.886).
-    std::vector<double> off(n);
-    for (int i = 0; i < n; ++i) off[i] = std::abs(light[i] - light_mean);
-    std::vector<double> sorted_off = off;
-    std::sort(sorted_off.begin(), sorted_off.end());
-    const double near = regress ? sorted_off[(n - 1) / 2] : std::numeric_limits<double>::infinity();
-    for (int i = 0; i < n; ++i) {
-      if (off[i] > near) continue;
-      const double gain = screen_level[i] >= 0 && m.mean_screen_ > 0 ? screen_level[i] / m.mean_screen_
-                                                                       : m.EstimateScreenGain(frames[i]);
-      const cv::Mat z = m.Normalised(frames[i], static_cast<float>(regress ? light[i] : m.EstimateLight(frames[i])),
-                                     static_cast<float>(gain));
-      if (pool) {
-        cv::Mat pooled;
-        cv::GaussianBlur(z, pooled, cv::Size(), m.PoolSigmaPx(size.width));
-        pooled_sq += pooled.dot(pooled);
-      }
-      if (outline) {
-        cv::Mat smooth, laplacian;
-        cv::GaussianBlur(z.mul(m.sigma_), smooth, cv::Size(), m.OutlineSigmaPx(size.width));
-        cv::Laplacian(smooth, laplacian, CV_32F);
-        smooth_sq += smooth.dot(smooth);
-        laplacian_sq += laplacian.dot(laplacian);
-      }
-      count += z.total();
-    }
-    // Floors: what 8-bit rounding alone gives after the same filters (white
-    // noise of 1/√12 grey levels a pixel; in z, over the floor of σ). Frames
-    // without noise (the `clean` preset) would otherwise set the thresholds
-    // at nothing (the old floor of 1e-3: a thousandth of z or of a grey
-    // level), and the faintest tail of the blurred outline would join the body.
-    const auto filtered_norm = GaussianNorm;
-    const double rounding = 1 / std::sqrt(12.0);
-    // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
-    const auto rms = [&](double sum_sq, double floor) {
-      return std::max(floor, std::sqrt(sum_sq / count * n / dof));
-    };
+}
+
+void BackgroundModel::MeasureTrainingNoise(const TrainingSet& set,
+                                           bool regress,
+                                           int dof,
+                                           const std::vector<double>& screen_level) {
+  const int n = set.n;
+  const cv::Size size = set.size;
+  const std::vector<double>& light = set.light;
+  const bool pool = set.flicker && options_.pool_sigma > 0, outline = set.flicker && options_.outline_sigma > 0;
+  if (!(pool || outline)) return;
+  double pooled_sq = 0, smooth_sq = 0, laplacian_sq = 0;
+  size_t count = 0;
+  // With the light regressed, on the half of the frames whose light is
+  // nearest the mean: the ends of a calibration sweep hold the smoothed
+  // slopes' error times a light change several times a sequence's (its
+  // content stays within ±10% of the sweep's middle, flashes aside), and
+  // set in it the thresholds rose (closed loop 0.877 against 0.886).
+  std::vector<double> off(n);
+  for (int i = 0; i < n; ++i) off[i] = std::abs(light[i] - set.light_mean);
+  std::vector<double> sorted_off = off;
+  std::sort(sorted_off.begin(), sorted_off.end());
+  const double near = regress ? sorted_off[(n - 1) / 2] : std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i) {
+    if (off[i] > near) continue;
+    const cv::Mat& frame = set.frames[i];
+    const double gain = screen_level[i] >= 0 && mean_screen_ > 0 ? screen_level[i] / mean_screen_
+                                                                   : EstimateScreenGain(frame);
+    const cv::Mat z = Normalised(frame, static_cast<float>(regress ? light[i] : EstimateLight(frame)),
+                                 static_cast<float>(gain));
     if (pool) {
-      const double floor = filtered_norm(m.PoolSigmaPx(size.width), false) * rounding / options.min_sigma;
-      m.pooled_noise_ = rms(pooled_sq, floor);
+      cv::Mat pooled;
+      cv::GaussianBlur(z, pooled, cv::Size(), PoolSigmaPx(size.width));
+      pooled_sq += pooled.dot(pooled);
     }
     if (outline) {
-      const double sigma = m.OutlineSigmaPx(size.width);
-      m.smoothed_noise_ = rms(smooth_sq, filtered_norm(sigma, false) * rounding);
-      m.outline_noise_ = rms(laplacian_sq, filtered_norm(sigma, true) * rounding);
+      cv::Mat smooth, laplacian;
+      cv::GaussianBlur(z.mul(sigma_), smooth, cv::Size(), OutlineSigmaPx(size.width));
+      cv::Laplacian(smooth, laplacian, CV_32F);
+      smooth_sq += smooth.dot(smooth);
+      laplacian_sq += laplacian.dot(laplacian);
     }
+    count += z.total();
   }
-  return m;
+  // Floors: what 8-bit rounding alone gives after the same filters (white
+  // noise of 1/√12 grey levels a pixel; in z, over the floor of σ). Frames
+  // without noise (the `clean` preset) would otherwise set the thresholds
+  // at nothing (the old floor of 1e-3: a thousandth of z or of a grey
+  // level), and the faintest tail of the blurred outline would join the body.
+  const auto filtered_norm = GaussianNorm;
+  const double rounding = 1 / std::sqrt(12.0);
+  // The sample σ of few frames makes z's spread shrink by sqrt(dof / n).
+  const auto rms = [&](double sum_sq, double floor) {
+    return std::max(floor, std::sqrt(sum_sq / count * n / dof));
+  };
+  if (pool) {
+    const double floor = filtered_norm(PoolSigmaPx(size.width), false) * rounding / options_.min_sigma;
+    pooled_noise_ = rms(pooled_sq, floor);
+  }
+  if (outline) {
+    const double sigma = OutlineSigmaPx(size.width);
+    smoothed_noise_ = rms(smooth_sq, filtered_norm(sigma, false) * rounding);
+    outline_noise_ = rms(laplacian_sq, filtered_norm(sigma, true) * rounding);
+  }
 }
 
 cv::Mat BackgroundModel::Normalised(const cv::Mat& frame, float light, float screen_gain) const {
@@ -399,11 +451,11 @@ double BackgroundModel::EstimateLight(const cv::Mat& frame) const {
 SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   CV_Assert(frame.type() == CV_8UC1 && frame.size() == a_.size());
   SilhouetteResult r;
-  r.light_level = options_.model == "flicker" ? EstimateLight(frame) : mean_light_;
+  r.light_level = options_.model == BackgroundKind::kFlicker ? EstimateLight(frame) : mean_light_;
   r.screen_gain = EstimateScreenGain(frame);
   const cv::Mat z = Normalised(frame, static_cast<float>(r.light_level), static_cast<float>(r.screen_gain));
   r.raw = cv::abs(z) > options_.threshold_sigma;
-  if (options_.model == "flicker" && options_.pool_sigma > 0) {
+  if (options_.model == BackgroundKind::kFlicker && options_.pool_sigma > 0) {
     cv::Mat pooled;
     cv::GaussianBlur(z, pooled, cv::Size(), PoolSigmaPx(frame.cols));
     // Hysteresis: weak pooled evidence counts where it connects to strong.
@@ -457,7 +509,7 @@ SilhouetteResult BackgroundModel::Segment(const cv::Mat& frame) const {
   }
   r.mask = r.raw.clone();
   const double scale = frame.cols / 320.0;
-  const bool refine = options_.model == "flicker" && options_.outline_sigma > 0;
+  const bool refine = options_.model == BackgroundKind::kFlicker && options_.outline_sigma > 0;
   const int min_area = static_cast<int>(options_.min_blob_fraction * frame.total());
   const int near_px = static_cast<int>(std::lround(options_.near_blob_px * scale));
   const int near_min_area = static_cast<int>(options_.near_blob_min_fraction * frame.total());

@@ -42,8 +42,15 @@
 
 namespace irbench {
 
+// Which background model segments the frames: the per-pixel light-following
+// model (flicker) or the thesis's per-pixel Gaussian (plain, 3.1).
+enum class BackgroundKind { kFlicker, kPlain };
+// "flicker" / "plain"; nullopt for another name.
+std::optional<BackgroundKind> ParseBackgroundKind(const std::string& name);
+const char* BackgroundKindName(BackgroundKind kind);
+
 struct BackgroundOptions {
-  std::string model = "flicker";  // "flicker" or "plain" (the thesis's)
+  BackgroundKind model = BackgroundKind::kFlicker;
   double threshold_sigma = 4.0;   // |I − μ| / σ above this: foreground
   double min_sigma = 2.0;         // grey levels; floors σ (8-bit quantisation, few frames)
   // Morphology, in pixels at 320x240 (scaled with the image width): an opening
@@ -99,8 +106,8 @@ struct BackgroundOptions {
   double outline_min_laplacian = 2.5;
   double outline_doubt = 16;
   double outline_max_hole = 8;
-  // Throws std::invalid_argument naming the option.
-  void Check() const;
+  // Throws InputError naming the option.
+  void Check() const;  // throws InputError naming the field
 };
 
 struct SilhouetteResult {
@@ -171,6 +178,43 @@ class BackgroundModel {
   // Moves `mask`'s outline to the inflection of the blurred edge (see
   // BackgroundOptions::outline_sigma).
   void RefineOutline(const cv::Mat& z, cv::Mat& mask) const;
+
+  // Train's steps (background_model.cc), on the training frames' statistics.
+  struct TrainingSet;
+  // Fits a, b and σ per pixel on the light level L (b by regression, or each
+  // pixel scaling with L) and picks the pixels L is read from (those that
+  // follow it clearly: b well above its noise), screen pixels excepted, into
+  // `light_pixels` (CV_8U). Returns the residual's degrees of freedom.
+  int FitLight(const TrainingSet& set, bool by_regression, cv::Mat& light_pixels);
+  // The screen pixels: the same model on the screen's own level G (the mean
+  // of its pixels; see the header), fitted over the training frames where G
+  // changes (a calibration sweep), else each pixel scales with it; so too
+  // when the regression leaves too few pixels to read G from (a change in
+  // training too small for the noise). Fills `screen_level` with G per
+  // frame, or -1 for all when G is to be read from the frames.
+  void FitScreen(const TrainingSet& set, std::vector<double>& screen_level);
+  // Fits the screen pixels' lines on G (`screen_level` per frame, mean
+  // `g_mean`, variance `g_var`, `sum_g` = Σ I·(G − Ḡ)) and picks the pixels G
+  // is read from; false when too few are.
+  bool FitScreenLines(const TrainingSet& set,
+                      const std::vector<double>& screen_level,
+                      double g_mean,
+                      double g_var,
+                      const cv::Mat& sum_g,
+                      bool by_regression);
+  // Keeps the pixels of `light_pixels` on even rows and columns, with a and b
+  // there, as the samples L is read from.
+  void SampleLightPixels(const cv::Mat& light_pixels);
+  // The noises the thresholds are set in, measured on the training frames:
+  // the pooled z's, and the outline refinement's (the difference I − μ(t)
+  // in grey levels smoothed by its Gaussian, and that smoothed difference's
+  // Laplacian), each one figure for the whole image. `regress`: L was
+  // regressed; `dof`: the light lines' degrees of freedom; `screen_level`:
+  // G per frame (-1: read from the frame).
+  void MeasureTrainingNoise(const TrainingSet& set,
+                            bool regress,
+                            int dof,
+                            const std::vector<double>& screen_level);
 };
 
 // The value of rank `k` (< v.size()) in `v`: what std::nth_element puts at

@@ -1,3 +1,4 @@
+#include "common/error.h"
 #include "tracker/silhouette/background_model.h"
 
 #include <Eigen/Core>
@@ -69,7 +70,7 @@ TEST(BackgroundModelTest, FlickerModelFollowsTheLightThePlainModelDoesNot) {
   std::uniform_real_distribution<double> level(30, 90);
   for (int i = 0; i < 12; ++i) training.push_back(stage.Frame(level(stage.rng), 1.5));
   BackgroundOptions flicker_options, plain_options;
-  plain_options.model = "plain";
+  plain_options.model = BackgroundKind::kPlain;
   const auto flicker = BackgroundModel::Train(training, flicker_options);
   const auto plain = BackgroundModel::Train(training, plain_options);
   ASSERT_TRUE(flicker && plain);
@@ -108,7 +109,7 @@ TEST(BackgroundModelTest, WithoutLightChangeBothModelsAgree) {
   std::vector<cv::Mat> training;
   for (int i = 0; i < 10; ++i) training.push_back(stage.Frame(50, 2.0));
   BackgroundOptions plain_options;
-  plain_options.model = "plain";
+  plain_options.model = BackgroundKind::kPlain;
   const auto flicker = BackgroundModel::Train(training, {});
   const auto plain = BackgroundModel::Train(training, plain_options);
   ASSERT_TRUE(flicker && plain);
@@ -121,8 +122,10 @@ TEST(BackgroundModelTest, WithoutLightChangeBothModelsAgree) {
   EXPECT_GT(IoU(p, person), 0.97);
   EXPECT_FALSE(BackgroundModel::Train({}, {}));
   BackgroundOptions bad;
-  bad.model = "mog";
-  EXPECT_THROW(bad.Check(), std::invalid_argument);
+  bad.threshold_sigma = 0;
+  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_EQ(ParseBackgroundKind("plain"), BackgroundKind::kPlain);
+  EXPECT_FALSE(ParseBackgroundKind("mog").has_value());
   EXPECT_NO_THROW(BackgroundOptions().Check());
   for (int field = 0; field < 7; ++field) {
     BackgroundOptions outline;
@@ -133,7 +136,14 @@ TEST(BackgroundModelTest, WithoutLightChangeBothModelsAgree) {
     if (field == 4) outline.outline_min_laplacian = -0.5;
     if (field == 5) outline.outline_doubt = std::nan("");
     if (field == 6) outline.outline_max_hole = -1;
-    EXPECT_THROW(outline.Check(), std::invalid_argument) << "field " << field;
+    const char* names[] = {"outline_sigma", "outline_sigma", "outline_band", "outline_band",
+                           "outline_min_laplacian", "outline_doubt", "outline_max_hole"};
+    try {
+      outline.Check();
+      ADD_FAILURE() << "field " << field << " passed";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), std::string("background.") + names[field]);  // the error names the option
+    }
   }
 }
 
@@ -257,7 +267,7 @@ TEST(BackgroundModelTest, SmoothedSlopesFollowAFlashUnderHeavyGrain) {
   EXPECT_GT(fp_unsmoothed, 0.05);
   BackgroundOptions bad;
   bad.slope_sigma = -1;
-  EXPECT_THROW(bad.Check(), std::invalid_argument);
+  EXPECT_THROW(bad.Check(), InputError);
 }
 
 TEST(BackgroundModelTest, CleanMaskRemovesSpecksAndSmallBlobs) {

@@ -1,6 +1,7 @@
 #include "tracker/silhouette/shadow_removal.h"
 
 #include "tracker/silhouette/internal/box.h"
+#include "common/error.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,15 +11,15 @@
 namespace irbench {
 
 void ShadowOptions::Check() const {
-  if (!(blur_sigma >= 0)) throw std::invalid_argument("shadow blur_sigma: must be >= 0");
+  if (!(blur_sigma >= 0)) throw InputError("", "shadow.blur_sigma", "must be >= 0");
   if (!(canny_low > 0 && canny_high >= canny_low)) {
-    throw std::invalid_argument("shadow canny thresholds: need 0 < low <= high");
+    throw InputError("", "shadow.canny_thresholds", "need 0 < low <= high");
   }
   if (!(background_edge_rate > 0 && background_edge_rate <= 1)) {
-    throw std::invalid_argument("shadow background_edge_rate: must be in (0, 1]");
+    throw InputError("", "shadow.background_edge_rate", "must be in (0, 1]");
   }
-  if (edge_dilate < 0 || edge_reach < 0) throw std::invalid_argument("shadow edge_dilate/edge_reach: must be >= 0");
-  if (min_directions < 1 || min_directions > 4) throw std::invalid_argument("shadow min_directions: must be 1..4");
+  if (edge_dilate < 0 || edge_reach < 0) throw InputError("", "shadow.edge_dilate/edge_reach", "must be >= 0");
+  if (min_directions < 1 || min_directions > 4) throw InputError("", "shadow.min_directions", "must be 1..4");
 }
 
 cv::Mat ShadowRemover::Edges(const cv::Mat& frame) const {

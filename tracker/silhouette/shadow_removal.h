@@ -27,7 +27,7 @@ struct ShadowOptions {
   int edge_reach = 2;
   // How many of the four scan directions must enclose a pixel (1..4).
   int min_directions = 1;
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;  // throws InputError naming the field
 };
 
 class ShadowRemover {

@@ -1,0 +1,73 @@
+// `irbench track`: the tracker over a sequence folder.
+
+#include <iostream>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cli/commands.h"
+#include "common/error.h"
+#include "tracker/pipeline/track_job.h"
+
+namespace irbench::cli {
+namespace {
+
+// What `irbench track`'s flags bind to.
+struct TrackArgs {
+  TrackJobOptions job;
+  std::string sequence, out;
+  int frames = 0;
+  // The tracker settings as typed (key -> text), applied after parsing so
+  // that a bad value is one InputError naming the flag.
+  std::vector<std::pair<const TrackSetting*, std::string>> typed;
+};
+
+// One flag per tracker setting, from the binding table (track_settings.h).
+void AddTrackerSettingOptions(CLI::App* cmd, TrackArgs& args) {
+  for (const TrackSetting& setting : TrackSettings()) {
+    if (const auto* flag = std::get_if<BoolBinding>(&setting.binding)) {
+      cmd->add_flag_callback(
+          setting.flag,
+          [&args, &setting, value = flag->flag_value] {
+            args.typed.emplace_back(&setting, value ? "true" : "false");
+          },
+          setting.help);
+      continue;
+    }
+    CLI::Option* option = cmd->add_option_function<std::string>(
+        setting.flag, [&args, &setting](const std::string& text) { args.typed.emplace_back(&setting, text); },
+        setting.help);
+    option->type_name(TypeName(setting));
+    if (setting.key != "rest_model") option->default_str(DefaultText(setting));
+  }
+}
+
+// Runs the track job; prints its output folder.
+int RunTrack(const CLI::App& cmd, TrackArgs& args) {
+  TrackJobOptions& track = args.job;
+  track.sequence = args.sequence;
+  track.out = args.out;
+  for (const auto& [setting, text] : args.typed) SetFromText(*setting, text, track.tracker);
+  if (cmd.count("--frames") > 0) track.frames = args.frames;
+  std::cout << RunTrackJob(track).string() << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+std::vector<Command> AddTrackCommand(CLI::App& app) {
+  auto args = std::make_shared<TrackArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "track", "Run the tracker on a sequence folder (frames, calibration and empty-stage frames only)");
+  cmd->add_option("SEQ", args->sequence, "sequence folder written by render")->required();
+  AddTrackerSettingOptions(cmd, *args);
+  cmd->add_flag("--overlays", args->job.overlays, "also write debug overlays (PNG, colour)");
+  cmd->add_flag("--ply", args->job.ply, "also write the voxel and polyhedral hulls per frame as PLY");
+  cmd->add_option("--frames", args->frames, "frames to process (default: all)");
+  cmd->add_option("--out", args->out, "output folder (default: SEQ/track)");
+  cmd->add_flag("--force", args->job.overwrite, "replace an existing output folder");
+  return {{cmd, [cmd, args] { return RunTrack(*cmd, *args); }}};
+}
+
+}  // namespace irbench::cli

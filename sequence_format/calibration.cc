@@ -1,0 +1,228 @@
+#include "sequence_format/calibration.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/json_reader.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+namespace {
+
+// The FileStorage keys of one camera.
+std::string KKey(const std::string& cam) {
+  return "K_" + cam;
+}
+std::string DistKey(const std::string& cam) {
+  return "dist_" + cam;
+}
+std::string RvecKey(const std::string& cam) {
+  return "R_" + cam;
+}
+std::string RotKey(const std::string& cam) {
+  return "Rot_" + cam;
+}
+std::string TKey(const std::string& cam) {
+  return "T_" + cam;
+}
+constexpr char kNamesKey[] = "names";
+
+cv::Mat ToCv(const Eigen::MatrixXd& m) {
+  cv::Mat out(static_cast<int>(m.rows()), static_cast<int>(m.cols()), CV_64F);
+  for (int r = 0; r < m.rows(); ++r) {
+    for (int c = 0; c < m.cols(); ++c) out.at<double>(r, c) = m(r, c);
+  }
+  return out;
+}
+
+void WriteNames(cv::FileStorage& fs, const std::vector<Camera>& cameras) {
+  fs << kNamesKey << "[";
+  for (const Camera& cam : cameras) fs << cam.name;
+  fs << "]";
+}
+
+// A rows x cols matrix of finite doubles under `key`; InputError otherwise.
+cv::Mat ReadMatrix(const cv::FileStorage& fs,
+                   const std::string& file,
+                   const std::string& key,
+                   int rows,
+                   int cols) {
+  cv::Mat m;
+  try {
+    const cv::FileNode node = fs[key];
+    if (node.empty() || node.isNone()) throw InputError(file, key, "missing");
+    if (!node.isMap()) throw InputError(file, key, "not an opencv-matrix");
+    node >> m;
+  } catch (const cv::Exception& e) {
+    throw InputError(file, key, "not an opencv-matrix: " + e.msg);
+  }
+  if (m.empty()) throw InputError(file, key, "missing");
+  if (m.rows * m.cols != rows * cols) {
+    throw InputError(file, key,
+                     "expected " + std::to_string(rows) + "x" + std::to_string(cols) + " values");
+  }
+  m.convertTo(m, CV_64F);
+  if (!cv::checkRange(m)) throw InputError(file, key, "holds a NaN or an infinity");
+  return m.reshape(1, rows);
+}
+
+// Opens both FileStorage files for reading; InputError naming the one that fails.
+void OpenYaml(const fs::path& intri_file,
+              const fs::path& extri_file,
+              cv::FileStorage* intri,
+              cv::FileStorage* extri) {
+  try {
+    intri->open(intri_file.string(), cv::FileStorage::READ);
+    extri->open(extri_file.string(), cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw InputError(intri->isOpened() ? extri_file.string() : intri_file.string(), "",
+                     "unreadable: " + e.msg);
+  }
+  if (!intri->isOpened()) throw InputError(intri_file.string(), "", "unreadable");
+  if (!extri->isOpened()) throw InputError(extri_file.string(), "", "unreadable");
+}
+
+// K_ and dist_ of camera `cam.name` from intri.yml.
+void ReadIntrinsics(const cv::FileStorage& intri, const std::string& file, Camera& cam) {
+  const cv::Mat k = ReadMatrix(intri, file, KKey(cam.name), 3, 3);
+  cam.fx = k.at<double>(0, 0), cam.fy = k.at<double>(1, 1);
+  cam.cx = k.at<double>(0, 2), cam.cy = k.at<double>(1, 2);
+  if (!(cam.fx > 0 && cam.fy > 0))
+    throw InputError(file, KKey(cam.name), "focal lengths must be > 0");
+  const cv::Mat dist = ReadMatrix(intri, file, DistKey(cam.name), 1, 5);
+  for (int i = 0; i < 5; ++i) cam.dist[i] = dist.at<double>(0, i);
+}
+
+// Rot_ and T_ of camera `cam.name` from extri.yml: cam_from_world.
+void ReadExtrinsics(const cv::FileStorage& extri, const std::string& file, Camera& cam) {
+  const cv::Mat rot = ReadMatrix(extri, file, RotKey(cam.name), 3, 3);
+  const cv::Mat t = ReadMatrix(extri, file, TKey(cam.name), 3, 1);
+  Eigen::Matrix3d r;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) r(a, b) = rot.at<double>(a, b);
+  if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+      r.determinant() < 0) {
+    throw InputError(file, RotKey(cam.name), "not a rotation (orthonormal, determinant +1)");
+  }
+  cam.cam_from_world.linear() = r;
+  cam.cam_from_world.translation() =
+      Eigen::Vector3d(t.at<double>(0), t.at<double>(1), t.at<double>(2));
+}
+
+// Image size, fps and exposure of camera `cam.name` from cameras.json's list.
+void ReadTiming(const JsonNode& list, const std::string& file, Camera& cam) {
+  bool found = false;
+  for (size_t i = 0; i < list.Size(); ++i) {
+    if (list[i].GetString("name") != cam.name) continue;
+    cam.width = list[i].GetInt("width");
+    cam.height = list[i].GetInt("height");
+    if (cam.width <= 0 || cam.height <= 0) list[i]["width"].Fail("image size must be positive");
+    cam.fps = list[i].GetDouble("fps");
+    if (!(cam.fps > 0 && std::isfinite(cam.fps))) list[i]["fps"].Fail("must be > 0");
+    cam.exposure_ms = list[i].GetDouble("exposure_ms", cam.exposure_ms);
+    found = true;
+  }
+  if (!found) throw InputError(file, "cameras", "no camera named '" + cam.name + "'");
+}
+
+}  // namespace
+
+std::string IntriYaml(const std::vector<Camera>& cameras) {
+  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  WriteNames(fs, cameras);
+  for (const Camera& cam : cameras) {
+    fs << KKey(cam.name) << ToCv(cam.K());
+    cv::Mat dist(1, 5, CV_64F);
+    for (int k = 0; k < 5; ++k) dist.at<double>(0, k) = cam.dist[k];
+    fs << DistKey(cam.name) << dist;
+  }
+  return fs.releaseAndGetString();
+}
+
+std::string ExtriYaml(const std::vector<Camera>& cameras) {
+  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  WriteNames(fs, cameras);
+  for (const Camera& cam : cameras) {
+    const cv::Mat rot = ToCv(cam.cam_from_world.linear());
+    cv::Mat rvec;
+    cv::Rodrigues(rot, rvec);
+    fs << RvecKey(cam.name) << rvec;
+    fs << RotKey(cam.name) << rot;
+    fs << TKey(cam.name) << ToCv(cam.cam_from_world.translation());
+  }
+  return fs.releaseAndGetString();
+}
+
+nlohmann::json CamerasJson(const std::vector<Camera>& cameras,
+                           const std::vector<nlohmann::json>& sensors) {
+  nlohmann::json j;
+  j["format"] = kCamerasFormat;
+  j["convention"] =
+      "OpenCV pinhole + Brown-Conrady (k1 k2 p1 p2 k3); pixel (0,0) is the centre of the top-left "
+      "pixel; R and T are cam_from_world, world in metres, z up";
+  j["cameras"] = nlohmann::json::array();
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& cam = cameras[i];
+    nlohmann::json c;
+    c["name"] = cam.name;
+    c["width"] = cam.width;
+    c["height"] = cam.height;
+    c["K"] = {{cam.fx, 0.0, cam.cx}, {0.0, cam.fy, cam.cy}, {0.0, 0.0, 1.0}};
+    c["dist"] = cam.dist;
+    const Eigen::Matrix3d r = cam.cam_from_world.linear();
+    c["R"] = {
+        {r(0, 0), r(0, 1), r(0, 2)}, {r(1, 0), r(1, 1), r(1, 2)}, {r(2, 0), r(2, 1), r(2, 2)}};
+    const Eigen::Vector3d t = cam.cam_from_world.translation();
+    c["T"] = {t.x(), t.y(), t.z()};
+    const Eigen::Vector3d center = cam.CenterInWorld();
+    c["center_in_world"] = {center.x(), center.y(), center.z()};
+    c["fps"] = cam.fps;
+    c["exposure_ms"] = cam.exposure_ms;
+    c["sensor"] = sensors.at(i);
+    j["cameras"].push_back(c);
+  }
+  return j;
+}
+
+void WriteCalibration(const fs::path& sequence_dir,
+                      const std::vector<Camera>& cameras,
+                      const std::vector<nlohmann::json>& sensors) {
+  AtomicWriteFile(sequence_dir / kIntriFile, IntriYaml(cameras));
+  AtomicWriteFile(sequence_dir / kExtriFile, ExtriYaml(cameras));
+  AtomicWriteFile(sequence_dir / kCamerasFile, CamerasJson(cameras, sensors).dump(2) + "\n");
+}
+
+std::vector<Camera> ReadCalibration(const fs::path& dir) {
+  const fs::path intri_file = dir / kIntriFile, extri_file = dir / kExtriFile;
+  const fs::path cameras_file = dir / kCamerasFile;
+  for (const fs::path& f : {intri_file, extri_file, cameras_file}) {
+    if (!fs::is_regular_file(f))
+      throw InputError(f.string(), "", "missing (not a sequence folder?)");
+  }
+  cv::FileStorage intri, extri;
+  OpenYaml(intri_file, extri_file, &intri, &extri);
+  std::vector<std::string> names;
+  try {
+    intri[kNamesKey] >> names;
+  } catch (const cv::Exception& e) {
+    throw InputError(intri_file.string(), kNamesKey, "expected a list of camera names: " + e.msg);
+  }
+  if (names.empty()) throw InputError(intri_file.string(), kNamesKey, "missing or empty");
+  const JsonNode cameras_json = ParseJsonFile(cameras_file.string());
+  const JsonNode list = cameras_json["cameras"];
+  std::vector<Camera> cameras;
+  for (const std::string& name : names) {
+    Camera cam;
+    cam.name = name;
+    ReadIntrinsics(intri, intri_file.string(), cam);
+    ReadExtrinsics(extri, extri_file.string(), cam);
+    ReadTiming(list, cameras_file.string(), cam);
+    cameras.push_back(cam);
+  }
+  return cameras;
+}
+
+}  // namespace irbench

@@ -1,0 +1,264 @@
+#include "tracker/pipeline/track_settings.h"
+
+#include <cctype>
+#include <cstdio>
+
+#include "common/error.h"
+#include "common/json_reader.h"
+
+namespace irbench {
+namespace {
+
+std::string RangeText(double min, double max) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "must be in %g..%g", min, max);
+  return text;
+}
+
+std::string ChoicesText(const std::vector<std::string>& choices) {
+  std::string out;
+  for (const std::string& c : choices) out += (out.empty() ? "" : ", ") + c;
+  return out;
+}
+
+// The value as it would be typed, for error messages.
+std::string ValueText(const nlohmann::json& value) {
+  if (value.is_string()) return value.get<std::string>();
+  if (value.is_number_float()) {
+    char text[48];
+    std::snprintf(text, sizeof(text), "%g", value.get<double>());
+    return text;
+  }
+  return value.dump();
+}
+
+std::vector<TrackSetting> MakeSettings() {
+  std::vector<TrackSetting> s;
+  s.push_back({"stage", "--stage",
+               "how far to go: pose (front end + particle-filter pose, joints and pointing) or\n"
+               "features (silhouettes, axis points, hull only)",
+               ChoiceBinding{{"features", "pose"},
+                             [](const TrackerSettings& t) -> std::string {
+                               return t.stage == TrackStage::kFeatures ? "features" : "pose";
+                             },
+                             [](TrackerSettings& t, const std::string& v) {
+                               t.stage =
+                                   v == "features" ? TrackStage::kFeatures : TrackStage::kPose;
+                             }}});
+  s.push_back({"particles", "--particles", "pose: particles of the filter (thesis 6.3)",
+               IntBinding{[](TrackerSettings& t) -> int& { return t.pose.particles; }, 1, 100000}});
+  s.push_back(
+      {"refine_fraction", "--refine-fraction",
+       "pose: share of the particles refined by 2D-3D ICP each frame (thesis 6.3.3)",
+       DoubleBinding{[](TrackerSettings& t) -> double& { return t.pose.refine_fraction; }, 0, 1}});
+  s.push_back({"seed", "--seed", "pose: seed of the filter's random stream",
+               Uint64Binding{[](TrackerSettings& t) -> uint64_t& { return t.pose.seed; }}});
+  s.push_back(
+      {"rest_model", "--rest-model",
+       "pose: rest-state SVM (default: tracker/models/rest_svm.yml when present)",
+       PathBinding{[](TrackerSettings& t) -> std::filesystem::path& { return t.rest_model; }}});
+  s.push_back({"background_model", "--background-model",
+               "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)",
+               ChoiceBinding{{"flicker", "plain"},
+                             [](const TrackerSettings& t) -> std::string {
+                               return BackgroundKindName(t.frontend.background.model);
+                             },
+                             [](TrackerSettings& t, const std::string& v) {
+                               t.frontend.background.model = *ParseBackgroundKind(v);
+                             }}});
+  s.push_back(
+      {"remove_shadows", "--keep-shadows", "skip the edge-based shadow removal",
+       BoolBinding{[](TrackerSettings& t) -> bool& { return t.frontend.remove_shadows; }, false}});
+  s.push_back(
+      {"shadow_edge_scale", "--shadow-edge-scale",
+       "shadow removal's edge thresholds times this, 0.25-8 (1: set for the thesis preset's\n"
+       "washed-out images; 2 for the clean preset with --shadows on)",
+       DoubleBinding{[](TrackerSettings& t) -> double& { return t.shadow_edge_scale; }, 0.25, 8}});
+  s.push_back(
+      {"hull_missing_views", "--hull-missing-views",
+       "voxel hull: cameras allowed to disagree, 0 or 1 (0: the thesis's hull; 1 keeps what one "
+       "view lost)",
+       IntBinding{[](TrackerSettings& t) -> int& { return t.frontend.voxels.max_missing_views; }, 0,
+                  1}});
+  return s;
+}
+
+}  // namespace
+
+const std::vector<TrackSetting>& TrackSettings() {
+  static const std::vector<TrackSetting> settings = MakeSettings();
+  return settings;
+}
+
+const TrackSetting* FindTrackSetting(const std::string& key) {
+  for (const TrackSetting& s : TrackSettings()) {
+    if (s.key == key) return &s;
+  }
+  return nullptr;
+}
+
+nlohmann::json SettingValue(const TrackSetting& setting, const TrackerSettings& settings) {
+  TrackerSettings& t = const_cast<TrackerSettings&>(settings);  // the refs only read here
+  return std::visit(
+      [&](const auto& b) -> nlohmann::json {
+        using B = std::decay_t<decltype(b)>;
+        if constexpr (std::is_same_v<B, ChoiceBinding>) {
+          return b.get(settings);
+        } else if constexpr (std::is_same_v<B, PathBinding>) {
+          return b.ref(t).string();
+        } else {
+          return b.ref(t);
+        }
+      },
+      setting.binding);
+}
+
+std::string SettingProblem(const TrackSetting& setting, const TrackerSettings& settings) {
+  TrackerSettings& t = const_cast<TrackerSettings&>(settings);  // the refs only read here
+  return std::visit(
+      [&](const auto& b) -> std::string {
+        using B = std::decay_t<decltype(b)>;
+        if constexpr (std::is_same_v<B, IntBinding> || std::is_same_v<B, DoubleBinding>) {
+          const double v = b.ref(t);
+          return v >= b.min && v <= b.max ? "" : RangeText(b.min, b.max);
+        } else if constexpr (std::is_same_v<B, ChoiceBinding>) {
+          const std::string v = b.get(settings);
+          for (const std::string& c : b.choices) {
+            if (c == v) return "";
+          }
+          return "must be one of " + ChoicesText(b.choices);
+        } else {
+          return "";
+        }
+      },
+      setting.binding);
+}
+
+void SetFromJson(const TrackSetting& setting, const JsonNode& node, TrackerSettings& settings) {
+  std::visit(
+      [&](const auto& b) {
+        using B = std::decay_t<decltype(b)>;
+        if constexpr (std::is_same_v<B, IntBinding>) {
+          b.ref(settings) = node.Int();
+        } else if constexpr (std::is_same_v<B, DoubleBinding>) {
+          b.ref(settings) = node.Number();
+        } else if constexpr (std::is_same_v<B, Uint64Binding>) {
+          if (!node.raw().is_number_unsigned()) node.Fail("expected an unsigned integer");
+          b.ref(settings) = node.raw().get<uint64_t>();
+        } else if constexpr (std::is_same_v<B, BoolBinding>) {
+          b.ref(settings) = node.Bool();
+        } else if constexpr (std::is_same_v<B, PathBinding>) {
+          b.ref(settings) = node.String();
+        } else {
+          const std::string v = node.String();
+          bool known = false;
+          for (const std::string& c : b.choices) known = known || c == v;
+          if (!known) node.Fail("must be one of " + ChoicesText(b.choices));
+          b.set(settings, v);
+        }
+      },
+      setting.binding);
+  if (const std::string problem = SettingProblem(setting, settings); !problem.empty())
+    node.Fail(problem);
+}
+
+void SetFromText(const TrackSetting& setting, const std::string& text, TrackerSettings& settings) {
+  const auto fail = [&](const std::string& problem) {
+    throw InputError("", setting.flag, "'" + text + "': " + problem);
+  };
+  std::visit(
+      [&](const auto& b) {
+        using B = std::decay_t<decltype(b)>;
+        size_t used = 0;
+        try {
+          if constexpr (std::is_same_v<B, IntBinding>) {
+            b.ref(settings) = std::stoi(text, &used);
+          } else if constexpr (std::is_same_v<B, DoubleBinding>) {
+            b.ref(settings) = std::stod(text, &used);
+          } else if constexpr (std::is_same_v<B, Uint64Binding>) {
+            if (text.find_first_not_of("0123456789") != std::string::npos)
+              fail("expected an unsigned integer");
+            b.ref(settings) = std::stoull(text, &used);
+          } else if constexpr (std::is_same_v<B, BoolBinding>) {
+            if (text != "true" && text != "false") fail("expected true or false");
+            b.ref(settings) = text == "true";
+            used = text.size();
+          } else if constexpr (std::is_same_v<B, PathBinding>) {
+            b.ref(settings) = text;
+            used = text.size();
+          } else {
+            bool known = false;
+            for (const std::string& c : b.choices) known = known || c == text;
+            if (!known) fail("must be one of " + ChoicesText(b.choices));
+            b.set(settings, text);
+            used = text.size();
+          }
+        } catch (const std::logic_error&) {  // std::invalid_argument, std::out_of_range
+          fail(std::is_same_v<B, DoubleBinding> ? "expected a number"
+                                                : "expected an integer in range");
+        }
+        if (used != text.size()) fail("expected a number");
+      },
+      setting.binding);
+  if (const std::string problem = SettingProblem(setting, settings); !problem.empty())
+    fail(problem);
+}
+
+std::string DefaultText(const TrackSetting& setting) {
+  return ValueText(SettingValue(setting, TrackerSettings()));
+}
+
+std::string TypeName(const TrackSetting& setting) {
+  return std::visit(
+      [](const auto& b) -> std::string {
+        using B = std::decay_t<decltype(b)>;
+        if constexpr (std::is_same_v<B, IntBinding>) return "INT";
+        if constexpr (std::is_same_v<B, Uint64Binding>) return "UINT";
+        if constexpr (std::is_same_v<B, DoubleBinding>) return "FLOAT";
+        if constexpr (std::is_same_v<B, PathBinding>) return "PATH";
+        if constexpr (std::is_same_v<B, ChoiceBinding>) return "TEXT";
+        return "";
+      },
+      setting.binding);
+}
+
+void CheckTrackerSettings(const TrackerSettings& settings) {
+  for (const TrackSetting& s : TrackSettings()) {
+    if (const std::string problem = SettingProblem(s, settings); !problem.empty()) {
+      throw InputError("", s.flag, "'" + ValueText(SettingValue(s, settings)) + "': " + problem);
+    }
+  }
+  settings.frontend.Check();
+  settings.pose.Check();
+}
+
+nlohmann::json SettingsJson(const TrackerSettings& settings) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const TrackSetting& s : TrackSettings()) j[s.key] = SettingValue(s, settings);
+  return j;
+}
+
+std::string NonDefaultSettingsTag(const TrackerSettings& settings) {
+  const TrackerSettings defaults;
+  std::string tag;
+  for (const TrackSetting& s : TrackSettings()) {
+    const nlohmann::json value = SettingValue(s, settings);
+    if (value == SettingValue(s, defaults)) continue;
+    tag += (tag.empty() ? "" : "-") + s.key + "=" + ValueText(value);
+  }
+  for (char& c : tag) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '=' && c != '-' &&
+        c != '_')
+      c = '_';
+  }
+  return tag;
+}
+
+FrontEndOptions EffectiveFrontEndOptions(const TrackerSettings& settings) {
+  FrontEndOptions options = settings.frontend;
+  options.shadow.canny_low *= settings.shadow_edge_scale;
+  options.shadow.canny_high *= settings.shadow_edge_scale;
+  return options;
+}
+
+}  // namespace irbench

@@ -1,0 +1,70 @@
+#pragma once
+// Per-user body calibration (thesis 6.1, model configuration; 6.1.2, "Model
+// Scaling by 3D Height"): the ellipsoid model's size for the user the pose
+// tracker follows. When a user enters, the model takes the voxel hull's top
+// for its height; over the first tracked frames the height is the median of
+// the hull's tops and the girth the median of the best girths against the
+// silhouettes, while the arms are below the shoulders; the arm thickness is
+// the median diameter of the 3D arm axis points. The thesis configures the
+// model "only ... at the start of body tracking", as here.
+//
+// The shape is the tracker's (PoseTracker keeps it); these functions update
+// it and say by what ratio the particles' waist heights must scale.
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "tracker/body_model/body_model.h"
+#include "tracker/pose/pose_tracker_options.h"
+
+namespace irbench {
+
+class BodyCalibration {
+ public:
+  // Reads height_frames and the arm_thickness_* settings of `options`.
+  explicit BodyCalibration(const PoseTrackerOptions& options) : options_(options) {}
+
+  // The log-likelihood (thesis 6.3.1) of a pose for a body shape.
+  using ShapeScore = std::function<double(const BodyShape&, const BodyPose&)>;
+
+  // A new user: forgets every measurement and returns the first model, as
+  // tall as the voxel hull's top `top_m` (metres, clamped to 1.2-2.2), girth 1.
+  BodyShape Start(double top_m);
+
+  // Has a height been measured (MeasureHeightAndGirth) since Start?
+  bool height_measured() const { return !heights_.empty(); }
+
+  // Until the height is measured, a model more than 10 % off the hull's top
+  // `top_m` (metres, clamped to 1.2-2.2) takes the top's height: updates
+  // `shape` and returns the ratio of the new height to the old, by which the
+  // particles' waist heights scale; nullopt when the model is kept.
+  std::optional<double> MatchHullTop(double top_m, BodyShape* shape) const;
+
+  // Thesis 6.1.2: one frame's measurement of the height (the hull's top
+  // `top_m`, metres) and the girth (the best against the silhouettes by
+  // `score`, the estimate `estimate` upright) while `tracking` and the
+  // estimate's arms are below its shoulders, over the first height_frames
+  // such frames. Updates `shape` to the medians and returns the ratio by
+  // which the waist heights scale; nullopt when nothing was measured.
+  std::optional<double> MeasureHeightAndGirth(bool tracking, const BodyPose& estimate, double top_m,
+                                              const ShapeScore& score, BodyShape* shape);
+
+  // The arms' thickness from this frame's 3D arm axis points' diameters
+  // `arm_diameters_m` (metres) while `tracking`, over the first
+  // arm_thickness_frames frames that have them; `shape` rescaled once
+  // arm_thickness_min_points are in.
+  void MeasureArmThickness(bool tracking, const std::vector<double>& arm_diameters_m, BodyShape* shape);
+
+  // The model for a height (metres) and girth, its arms as thick as measured.
+  BodyShape ShapeFor(double height_m, double girth) const;
+
+ private:
+  PoseTrackerOptions options_;
+  std::vector<double> heights_, girths_;
+  std::vector<double> arm_diameters_;  // metres, from the 3D arm axis points
+  int arm_frames_ = 0;                 // tracked frames that gave them
+  double arm_diameter_m_ = 0;          // their median; 0 until measured
+};
+
+}  // namespace irbench

@@ -1,0 +1,121 @@
+#pragma once
+// The pose tracker's settings (thesis 6.3-6.5; pose_tracker.h): the particle
+// filter's proposals and noise, the heading priors, the body calibration
+// (6.1.2), the rest state (6.4) and the head from the hull. Kept apart from
+// pose_tracker.h so that the tracker's parts (particle_filter.h,
+// body_calibration.h) can read them.
+
+#include <cstdint>
+
+#include "tracker/pose/icp.h"
+#include "tracker/pose/observation.h"
+#include "tracker/pose/pointing.h"
+
+namespace irbench {
+
+struct PoseTrackerOptions {
+  int particles = 100;
+  uint64_t seed = 1;
+  ObservationOptions observation;
+  // Proposal choice per particle (thesis 6.3.2), relative weights.
+  double p_random_walk = 0.70;
+  double p_body_position = 0.10;
+  double p_arm_direction = 0.12;
+  double p_default_pose = 0.08;
+  // Share of particles turned half way round with their arms swapped
+  // (FlippedPose), tried before the proposals above.
+  double p_flip = 0.03;
+  // Share of particles turned to another heading with their arms kept
+  // pointing where they point (TurnedPose): half face the screen, half turn
+  // by a random angle. A body stuck side-on after a walk turns back this way;
+  // the random walk's yaw steps are too small to leave that optimum. Not
+  // while the user walks or enters (the walk gives the heading then).
+  double p_turn = 0.04;
+  // Random-walk noise per frame at 30 fps (scaled by sqrt(dt * 30)).
+  double sigma_position_m = 0.02;
+  double sigma_yaw_rad = 0.06;
+  double sigma_torso_rad = 0.03;
+  double sigma_arm_rad = 0.12;
+  // Velocity: the fraction of the last frame's change carried forward, and its
+  // cap per frame (thesis: "a value cap of velocity ... needs to be applied").
+  double velocity_damping = 0.5;
+  double max_step_rad = 0.35;
+  double max_step_m = 0.08;
+  // Above this ground speed of the hull (m/s) the body-position proposal also
+  // turns the body to face where it walks.
+  double walking_speed_mps = 0.5;
+  // Heading priors, added to the log-likelihood as -w * (1 - cos(d)) / 2 for a
+  // heading d away from the preferred one: people face where they walk, and
+  // otherwise mostly face the screen. They only decide between hypotheses the
+  // silhouettes cannot tell apart (front and back look alike).
+  double walking_heading_prior = 5.0;
+  double screen_heading_prior = 4.0;
+  // After a walk, people keep facing about where they walked while they turn
+  // to the screen: for this long the preferred heading blends from the last
+  // walking direction to the screen's (linearly). A user first seen half in
+  // view is entering, heading for the stage's centre: the same memory.
+  double walk_memory_s = 2.0;
+  // The waist rises at most this far above its standing height (the shape's
+  // waist_height_m): the feet stay on the floor. Left free, the filter
+  // lifted tall bodies 3-5 cm to fit their silhouettes, raising the head
+  // that pointing rays start from. Crouching and bowing lower it freely.
+  double max_rise_m = 0.02;
+  // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
+  double refine_fraction = 0.2;
+  IcpOptions icp;
+  // Rest state (thesis 6.4): besides the SVM's vote, an arm the 3D axis
+  // points show apart from the body is at rest when the direction from the
+  // shoulder to their farthest point is within this of straight down. (The
+  // truth's rule: upper arm within 30 deg and forearm within 45 of the
+  // chest's down axis. Straight down stands in for the chest's axis, which
+  // the tracked torso gives only to a few degrees: against it, seeds 1-5 of
+  // the five demos made 251 errors in 25568 arm-frames, against straight
+  // down 220, both before rest_lifted_memory_s. A user bowing deeply with
+  // hanging arms is taken for at rest.)
+  double rest_seen_max_angle_deg = 34;
+  // An arm they do not show is at rest when forcing it down (to the best of
+  // six hanging poses, which the estimate then shows) costs less than this
+  // in the sum over cameras of log overlap ratio: the silhouettes cannot
+  // tell that arm from a hanging one ("when the arms ... are wrapped near
+  // the body, the silhouettes are visually nearly undistinguishable"). The
+  // SVM, trained on exact joints, takes a hanging arm the filter has put at
+  // the torso's side or behind it for a raised one. 0 turns the test off.
+  double rest_max_log_overlap_loss = 0.27;
+  // ... unless the axis points showed it lifted at least rest_lifted_angle_deg
+  // from straight down within the last rest_lifted_memory_s: an arm does not
+  // drop from there to the side unseen so fast; it has left the silhouettes
+  // (noise, an arm overhead against the head). On p1_demo_harsh, seeds 1-3,
+  // it cuts the arm-frames of a raised arm taken for hanging from 143 to 45.
+  double rest_lifted_angle_deg = 45;
+  double rest_lifted_memory_s = 0.5;
+  // The head joint, and so the pointing rays' origin, measured on the voxel
+  // hull (HullHeadCentre) where every camera's silhouette holds the model's
+  // head centre and the hull shows a head near it; the model's head
+  // otherwise. Five demos, seeds 1-3: pointing 2.27 -> 1.91 deg (p2 3.07 ->
+  // 2.18).
+  bool head_from_hull = true;
+  HullHeadOptions hull_head;
+  // Tracking is declared when the voxel hull sees a person and the best
+  // particle's mean overlap ratio reaches this.
+  double min_overlap = 0.35;
+  // "In view": a box of this half-width about the hull's root, from the floor
+  // to the body's height, projects inside every camera's image.
+  double view_margin_m = 0.35;
+  // Frames over which the height and girth are estimated after a user
+  // enters (medians of per-frame values, while the arms are below the
+  // shoulders).
+  int height_frames = 15;
+  // Arm thickness (BodyShape::arm_thickness) from the 3D arm axis points'
+  // diameters: their median over the first arm_thickness_frames tracked
+  // frames that have arm points (0 turns the measurement off), once
+  // arm_thickness_min_points are in, over arm_reference_diameter (a fraction
+  // of the height) times the height; at least 1 (the model's arms are sized
+  // for bare or tight sleeves), at most max_arm_thickness.
+  int arm_thickness_frames = 150;
+  int arm_thickness_min_points = 300;
+  double arm_reference_diameter = 0.055;
+  double max_arm_thickness = 1.3;
+  void Check() const;  // throws InputError naming the field
+};
+
+}  // namespace irbench
