@@ -22,8 +22,11 @@ struct AvatarArgs {
 // Adds `avatar export`; its arguments bind to `args`.
 CLI::App* AddAvatarExport(CLI::App* avatar_cmd, AvatarArgs& args) {
   CLI::App* cmd = avatar_cmd->add_subcommand(
-      "export", "Write an avatar as binary glTF (.glb): mesh, skeleton and skin, for Blender or any viewer");
-  cmd->add_option("AVATAR", args.export_name, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->required();
+      "export",
+      "Write an avatar as binary glTF (.glb): mesh, skeleton and skin, for Blender or any viewer");
+  cmd->add_option("AVATAR", args.export_name,
+                  "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")
+      ->required();
   cmd->add_option("OUT", args.out, "output .glb file")->required();
   cmd->add_flag("--force", args.force, "replace an existing file");
   return cmd;
@@ -54,8 +57,11 @@ std::vector<Command> AddAvatarCommand(CLI::App& app) {
   CLI::App* avatar_cmd = app.add_subcommand("avatar", "List, inspect and export avatars");
   avatar_cmd->require_subcommand(1);
   CLI::App* list = avatar_cmd->add_subcommand("list", "List the avatars in avatars/");
-  CLI::App* info = avatar_cmd->add_subcommand("info", "Height, triangles and closedness of an avatar");
-  info->add_option("AVATAR", args->info_name, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->required();
+  CLI::App* info =
+      avatar_cmd->add_subcommand("info", "Height, triangles and closedness of an avatar");
+  info->add_option("AVATAR", args->info_name,
+                   "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")
+      ->required();
   CLI::App* export_cmd = AddAvatarExport(avatar_cmd, *args);
   return {{list, RunAvatarList},
           {info, [args] { return RunAvatarInfo(*args); }},

@@ -52,8 +52,12 @@ struct RemoveOnExit {
 
 // Renders `frames` frame-sets to a temporary folder (removed afterwards) and
 // times the tracker's stages on them. `render`'s out is ignored.
-std::vector<TrackBenchRow> RenderAndTimeTracker(RenderJobOptions render, int frames, int repeats, int* cameras) {
-  const fs::path dir = fs::temp_directory_path() / ("irbench_bench_track_" + std::to_string(::getpid()));
+std::vector<TrackBenchRow> RenderAndTimeTracker(RenderJobOptions render,
+                                                int frames,
+                                                int repeats,
+                                                int* cameras) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("irbench_bench_track_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const RemoveOnExit cleanup{dir};
   render.frames = frames;
@@ -74,11 +78,14 @@ int RunBenchTrack(BenchTrackArgs& args) {
   if (args.repeats < 1) throw InputError("", "--repeats", "must be at least 1");
   int cameras = 0;
   const auto rows = RenderAndTimeTracker(render, args.frames, args.repeats, &cameras);
-  std::printf("# irbench bench track: rig %s, avatar %s, motion %s, sensor %s, %d cameras, %d frame-sets x %d\n",
-              render.rig.c_str(), render.avatar.c_str(), render.motion.c_str(), render.sensor.c_str(), cameras,
-              args.frames, args.repeats);
-  std::printf("| stage | median ms per frame-set | mean ms | frame-sets per second (from the mean) |\n"
-              "|---|---|---|---|\n");
+  std::printf(
+      "# irbench bench track: rig %s, avatar %s, motion %s, sensor %s, %d cameras, %d frame-sets x "
+      "%d\n",
+      render.rig.c_str(), render.avatar.c_str(), render.motion.c_str(), render.sensor.c_str(),
+      cameras, args.frames, args.repeats);
+  std::printf(
+      "| stage | median ms per frame-set | mean ms | frame-sets per second (from the mean) |\n"
+      "|---|---|---|---|\n");
   for (const auto& r : rows) {
     std::printf("| %s | %.2f | %.2f | %.1f |\n", r.stage.c_str(), r.median_ms, r.mean_ms,
                 r.mean_ms > 0 ? 1000.0 / r.mean_ms : 0.0);
@@ -97,8 +104,9 @@ int RunBenchRender(BenchRenderArgs& args) {
   std::printf("# irbench bench render: rig %s, avatar %s, motion %s, supersample %d\n",
               bench.rig.c_str(), bench.avatar.c_str(), bench.motion.c_str(), bench.supersample);
   std::printf("# %s\n", backend_description.c_str());
-  std::printf("| resolution | cameras | frame-sets | render frame-sets/s | ms/camera | "
-              "with PNG encode frame-sets/s |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "| resolution | cameras | frame-sets | render frame-sets/s | ms/camera | "
+      "with PNG encode frame-sets/s |\n|---|---|---|---|---|---|\n");
   for (const auto& r : results) {
     std::printf("| %s | %d | %d | %.1f | %.2f | %.1f |\n", r.label.c_str(), r.cameras, r.frames,
                 r.render_fps, r.ms_per_camera, r.encode_fps);
@@ -109,8 +117,10 @@ int RunBenchRender(BenchRenderArgs& args) {
 // Adds `bench render` under `bench_cmd`.
 Command AddBenchRender(CLI::App* bench_cmd) {
   auto args = std::make_shared<BenchRenderArgs>();
-  CLI::App* cmd = bench_cmd->add_subcommand(
-      "render", "Frame-sets per second of the render path at 1x and 2x the rig's resolution\n(320x240 and 640x480 for the shipped rigs)");
+  CLI::App* cmd =
+      bench_cmd->add_subcommand("render",
+                                "Frame-sets per second of the render path at 1x and 2x the rig's "
+                                "resolution\n(320x240 and 640x480 for the shipped rigs)");
   AddRenderInputOptions(cmd, args->render, args->backend, args->shadows);
   cmd->add_option("--frames", args->frames, "timed frame-sets per resolution")
       ->capture_default_str();
@@ -122,8 +132,9 @@ Command AddBenchTrack(CLI::App* bench_cmd) {
   auto args = std::make_shared<BenchTrackArgs>();
   args->render.sensor = "thesis";  // bench track's default preset, shown in its --help
   CLI::App* cmd = bench_cmd->add_subcommand(
-      "track", "Milliseconds per frame-set of the tracker's stages, on a sequence rendered for it\n"
-               "(images preloaded: decoding is not counted)");
+      "track",
+      "Milliseconds per frame-set of the tracker's stages, on a sequence rendered for it\n"
+      "(images preloaded: decoding is not counted)");
   AddRenderInputOptions(cmd, args->render, args->backend, args->shadows);
   cmd->add_option("--frames", args->frames, "frame-sets to render and time")->capture_default_str();
   cmd->add_option("--repeats", args->repeats, "passes over them")->capture_default_str();

@@ -37,13 +37,17 @@ std::vector<Command> AddDemoCommand(CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   DemoOptions& demo = args->job;
   CLI::App* cmd = app.add_subcommand(
-      "demo", "The main job: render the default session (theater4, thesis preset, about 20 s),\n"
-              "run the tracker, score it against the truth, print the tables and write report.html");
-  cmd->add_option("--out", args->out, "sequence folder, track/ and score/ go inside (default: renders/demo)");
+      "demo",
+      "The main job: render the default session (theater4, thesis preset, about 20 s),\n"
+      "run the tracker, score it against the truth, print the tables and write report.html");
+  cmd->add_option("--out", args->out,
+                  "sequence folder, track/ and score/ go inside (default: renders/demo)");
   cmd->add_option("--avatar", demo.avatar, "avatar name (avatars/) or file")->capture_default_str();
   cmd->add_option("--motion", demo.motion, "motion, as for render --motion")->capture_default_str();
-  cmd->add_option("--sensor", demo.sensor, "sensor preset: clean, thesis or harsh")->capture_default_str();
-  cmd->add_option("--frames", args->frames, "frames to render (default: the whole session; fewer for a quick look)");
+  cmd->add_option("--sensor", demo.sensor, "sensor preset: clean, thesis or harsh")
+      ->capture_default_str();
+  cmd->add_option("--frames", args->frames,
+                  "frames to render (default: the whole session; fewer for a quick look)");
   cmd->add_option("--seed", demo.seed, "seed for everything random")->capture_default_str();
   cmd->add_flag("--force", demo.overwrite, "replace an existing output folder");
   return {{cmd, [cmd, args] { return RunDemoCommand(*cmd, *args); }}};

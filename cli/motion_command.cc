@@ -13,12 +13,13 @@ namespace {
 // Adds `motion export`; its flags bind to `options`.
 CLI::App* AddMotionExport(CLI::App* motion_cmd, MotionExportOptions& options) {
   CLI::App* cmd = motion_cmd->add_subcommand(
-      "export", "Write a motion, posed on an avatar, as BVH (Blender, assimp, MotionBuilder open it)");
-  cmd->add_option("--motion", options.motion, "motion, as for render --motion")
-      ->required();
-  cmd->add_option("--avatar", options.avatar, "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")->capture_default_str();
-  cmd->add_option("--scene", options.scene, "scene (for pointing targets)")
+      "export",
+      "Write a motion, posed on an avatar, as BVH (Blender, assimp, MotionBuilder open it)");
+  cmd->add_option("--motion", options.motion, "motion, as for render --motion")->required();
+  cmd->add_option("--avatar", options.avatar,
+                  "avatar name (avatars/), avatar .json, or a rigged mesh (.glb/.gltf/.fbx/.dae)")
       ->capture_default_str();
+  cmd->add_option("--scene", options.scene, "scene (for pointing targets)")->capture_default_str();
   cmd->add_option("--fps", options.fps, "frames per second")->capture_default_str();
   cmd->add_option("--seed", options.seed, "seed of the person's style")->capture_default_str();
   cmd->add_option("OUT", options.out, "output .bvh file")->required();
@@ -49,7 +50,8 @@ int RunMotionExport(const MotionExportOptions& options) {
 std::vector<Command> AddMotionCommand(CLI::App& app) {
   CLI::App* motion_cmd = app.add_subcommand("motion", "List, inspect and export motions");
   motion_cmd->require_subcommand(1);
-  CLI::App* list = motion_cmd->add_subcommand("list", "List the library motions and motions/ files");
+  CLI::App* list =
+      motion_cmd->add_subcommand("list", "List the library motions and motions/ files");
   auto info_file = std::make_shared<std::string>();
   CLI::App* info = motion_cmd->add_subcommand(
       "info", "Describe a BVH or AMC clip: convention, frames, frame time, the joint map");

@@ -46,10 +46,11 @@ std::vector<Command> AddRenderCommand(CLI::App& app) {
   cmd->add_option("--background-frames", args->job.background_frames,
                   "empty-stage frames per camera")
       ->capture_default_str();
-  cmd->add_flag("--no-screen-sweep", args->no_sweep,
-                "film the empty stage with the screens playing their content; by default they show a "
-                "brightness ramp (0.25 to 1.75 of the content's level) so the tracker can tell their light "
-                "from the illuminators'");
+  cmd->add_flag(
+      "--no-screen-sweep", args->no_sweep,
+      "film the empty stage with the screens playing their content; by default they show a "
+      "brightness ramp (0.25 to 1.75 of the content's level) so the tracker can tell their light "
+      "from the illuminators'");
   cmd->add_option("--seed", args->job.seed, "seed for everything random")->capture_default_str();
   cmd->add_option("--out", args->out,
                   "output folder (default: renders/<rig>-<avatar>-<motion>-s<seed>)");

@@ -12,7 +12,10 @@ namespace irbench::cli {
 // Binds --scene, --rig, --avatar, --motion, --backend, --supersample, --sensor
 // and --shadows to `o`, `backend` and `shadows`; defaults shown are their
 // values now.
-void AddRenderInputOptions(CLI::App* cmd, RenderJobOptions& o, std::string& backend, std::string& shadows);
+void AddRenderInputOptions(CLI::App* cmd,
+                           RenderJobOptions& o,
+                           std::string& backend,
+                           std::string& shadows);
 
 // Sets o.shadows from --shadows ("on" or "off"); leaves the default when empty.
 void ApplyShadows(const std::string& shadows, RenderJobOptions& o);

@@ -38,19 +38,23 @@ int RunScore(ScoreArgs& args) {
 std::vector<Command> AddScoreCommand(CLI::App& app) {
   auto args = std::make_shared<ScoreArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "score", "Score a track file against the sequence's truth: the thesis's tables (joint errors with\n"
-               "Chauvenet outliers, pointing angles, rest state, motion labels; the silhouettes' IoU per camera\n"
-               "when irbench track's silhouettes/ lie beside the track file) as JSON, Markdown and CSV, and\n"
-               "report.html: the tables, plots and a frame viewer with the truth and the track drawn over\n"
-               "every camera's image, worst frames first");
+      "score",
+      "Score a track file against the sequence's truth: the thesis's tables (joint errors with\n"
+      "Chauvenet outliers, pointing angles, rest state, motion labels; the silhouettes' IoU per "
+      "camera\n"
+      "when irbench track's silhouettes/ lie beside the track file) as JSON, Markdown and CSV, "
+      "and\n"
+      "report.html: the tables, plots and a frame viewer with the truth and the track drawn over\n"
+      "every camera's image, worst frames first");
   cmd->add_option("SEQ", args->sequence, "sequence folder written by render")->required();
   cmd->add_option("--track", args->track, "track.jsonl to score (default: SEQ/track/track.jsonl)");
   cmd->add_option("--out", args->out, "output folder (default: SEQ/score)");
   cmd->add_flag("--include-rest-arms", args->job.score.include_rest_arms,
                 "also score elbows and wrists of arms at rest (the thesis leaves them out)");
   cmd->add_flag("--force", args->job.overwrite, "replace an existing output folder");
-  cmd->add_flag("--no-report", args->no_report,
-                "skip report.html (tables, gnuplot plots, frame viewer; opens offline in a browser)");
+  cmd->add_flag(
+      "--no-report", args->no_report,
+      "skip report.html (tables, gnuplot plots, frame viewer; opens offline in a browser)");
   return {{cmd, [args] { return RunScore(*args); }}};
 }
 

@@ -23,8 +23,10 @@ int RunSuiteCommand(SuiteArgs& args) {
   suite.baselines = args.baselines;
   suite.cache = args.cache;
   const SuiteResult r = RunSuite(suite);
-  std::cout << "# suite " << r.name << (suite.bless ? " (blessed)" : "") << "\n" << r.Table() << "\nreports:\n";
-  for (const auto& [scenario, report] : r.reports) std::cout << "  " << scenario << "  " << report.string() << "\n";
+  std::cout << "# suite " << r.name << (suite.bless ? " (blessed)" : "") << "\n"
+            << r.Table() << "\nreports:\n";
+  for (const auto& [scenario, report] : r.reports)
+    std::cout << "  " << scenario << "  " << report.string() << "\n";
   if (!r.pass) {
     int failed = 0;
     for (const auto& row : r.rows) failed += !row.pass;
@@ -38,13 +40,16 @@ int RunSuiteCommand(SuiteArgs& args) {
 
 std::vector<Command> AddSuiteCommand(CLI::App& app) {
   auto args = std::make_shared<SuiteArgs>();
-  CLI::App* suite_cmd = app.add_subcommand("suite", "Closed-loop accuracy regression: run a suite of scenarios");
+  CLI::App* suite_cmd =
+      app.add_subcommand("suite", "Closed-loop accuracy regression: run a suite of scenarios");
   suite_cmd->require_subcommand(1);
   CLI::App* run = suite_cmd->add_subcommand(
-      "run", "Render (cached), track and score every scenario of a suite; check thresholds and the\n"
-             "blessed baseline; print a pass/fail table; exit 1 on a regression");
+      "run",
+      "Render (cached), track and score every scenario of a suite; check thresholds and the\n"
+      "blessed baseline; print a pass/fail table; exit 1 on a regression");
   run->add_option("SUITE", args->name, "suite name (ci/suites/) or file")->required();
-  run->add_flag("--bless", args->job.bless, "write this run's figures as the new baseline (on purpose)");
+  run->add_flag("--bless", args->job.bless,
+                "write this run's figures as the new baseline (on purpose)");
   run->add_option("--baselines", args->baselines, "baseline folder (default: ci/baselines)");
   run->add_option("--cache", args->cache, "render cache folder (default: renders/cache)");
   run->add_option("--jobs", args->job.jobs, "scenarios at a time (default: the core count)")

@@ -36,10 +36,13 @@ void AddTrackerSettingOptions(CLI::App* cmd, TrackArgs& args) {
       continue;
     }
     CLI::Option* option = cmd->add_option_function<std::string>(
-        setting.flag, [&args, &setting](const std::string& text) { args.typed.emplace_back(&setting, text); },
+        setting.flag,
+        [&args, &setting](const std::string& text) { args.typed.emplace_back(&setting, text); },
         setting.help);
     option->type_name(TypeName(setting));
-    if (setting.key != "rest_model") option->default_str(DefaultText(setting));
+    if (const std::string default_text = DefaultText(setting); !default_text.empty()) {
+      option->default_str(default_text);
+    }
   }
 }
 
@@ -59,11 +62,13 @@ int RunTrack(const CLI::App& cmd, TrackArgs& args) {
 std::vector<Command> AddTrackCommand(CLI::App& app) {
   auto args = std::make_shared<TrackArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "track", "Run the tracker on a sequence folder (frames, calibration and empty-stage frames only)");
+      "track",
+      "Run the tracker on a sequence folder (frames, calibration and empty-stage frames only)");
   cmd->add_option("SEQ", args->sequence, "sequence folder written by render")->required();
   AddTrackerSettingOptions(cmd, *args);
   cmd->add_flag("--overlays", args->job.overlays, "also write debug overlays (PNG, colour)");
-  cmd->add_flag("--ply", args->job.ply, "also write the voxel and polyhedral hulls per frame as PLY");
+  cmd->add_flag("--ply", args->job.ply,
+                "also write the voxel and polyhedral hulls per frame as PLY");
   cmd->add_option("--frames", args->frames, "frames to process (default: all)");
   cmd->add_option("--out", args->out, "output folder (default: SEQ/track)");
   cmd->add_flag("--force", args->job.overwrite, "replace an existing output folder");

@@ -30,17 +30,21 @@ int RunTrainRest(TrainRestArgs& args) {
 }  // namespace
 
 std::vector<Command> AddTrainCommand(CLI::App& app) {
-  CLI::App* train_cmd = app.add_subcommand("train", "Train the tracker's learned parts from simulated truth");
+  CLI::App* train_cmd =
+      app.add_subcommand("train", "Train the tracker's learned parts from simulated truth");
   train_cmd->require_subcommand(1);
   auto args = std::make_shared<TrainRestArgs>();
   RestTrainingOptions& train_rest = args->job;
   CLI::App* cmd = train_cmd->add_subcommand(
-      "rest", "Rest-state SVM (thesis 6.4): RBF SVM on elbow and wrist in the upper-body frame, C and gamma\n"
-              "by k-fold cross-validation, from library motions played on avatars (no rendering)");
+      "rest",
+      "Rest-state SVM (thesis 6.4): RBF SVM on elbow and wrist in the upper-body frame, C and "
+      "gamma\n"
+      "by k-fold cross-validation, from library motions played on avatars (no rendering)");
   cmd->add_option("--avatars", train_rest.avatars, "avatars to sample")->capture_default_str();
   cmd->add_option("--motions", train_rest.motions, "library motions or motion files")
       ->capture_default_str();
-  cmd->add_option("--fps", train_rest.sample_fps, "samples per second of motion")->capture_default_str();
+  cmd->add_option("--fps", train_rest.sample_fps, "samples per second of motion")
+      ->capture_default_str();
   cmd->add_option("--folds", train_rest.folds, "cross-validation folds")->capture_default_str();
   cmd->add_option("--seed", train_rest.seed, "seed of the motions' styles")->capture_default_str();
   cmd->add_option("--out", args->out, "model file (default: tracker/models/rest_svm.yml)");

@@ -32,7 +32,7 @@ bool HasManifest(const fs::path& sequence_dir) {
 }
 
 void WriteManifest(const fs::path& sequence_dir, const nlohmann::json& manifest) {
-  const auto format = manifest.find("format");
+  const auto format = manifest.find(manifest_key::kFormat);
   if (format == manifest.end() || !format->is_string() ||
       format->get<std::string>() != kSequenceFormat) {
     throw RuntimeError("a manifest without \"format\": \"" + std::string(kSequenceFormat) + "\"");
@@ -45,24 +45,25 @@ Manifest ReadManifest(const fs::path& sequence_dir) {
   if (!fs::is_regular_file(path))
     throw InputError(path.string(), "", "missing (not a sequence folder?)");
   const JsonNode root = ParseJsonFile(path.string());
-  if (root.GetString("format") != kSequenceFormat) {
-    root["format"].Fail("expected \"" + std::string(kSequenceFormat) + "\"");
+  if (root.GetString(manifest_key::kFormat) != kSequenceFormat) {
+    root[manifest_key::kFormat].Fail("expected \"" + std::string(kSequenceFormat) + "\"");
   }
   Manifest m;
   m.json = root.raw();
-  if (root.Has("seed")) {
-    if (!root["seed"].raw().is_number_unsigned()) root["seed"].Fail("expected an unsigned integer");
-    m.seed = root["seed"].raw().get<uint64_t>();
+  if (root.Has(manifest_key::kSeed)) {
+    if (!root[manifest_key::kSeed].raw().is_number_unsigned())
+      root[manifest_key::kSeed].Fail("expected an unsigned integer");
+    m.seed = root[manifest_key::kSeed].raw().get<uint64_t>();
   }
-  m.fps = root.GetDouble("fps", 0.0);
-  m.frame_count = root.GetInt("frame_count", 0);
-  m.cameras = Strings(root, "cameras");
-  m.joints = Strings(root, "joints");
-  m.scene = NameOf(root, "scene", "name");
-  m.rig = NameOf(root, "rig", "name");
-  m.avatar = NameOf(root, "avatar", "name");
-  m.motion = NameOf(root, "motion", "name");
-  m.sensor = NameOf(root, "sensor", "preset");
+  m.fps = root.GetDouble(manifest_key::kFps, 0.0);
+  m.frame_count = root.GetInt(manifest_key::kFrameCount, 0);
+  m.cameras = Strings(root, manifest_key::kCameras);
+  m.joints = Strings(root, manifest_key::kJoints);
+  m.scene = NameOf(root, manifest_key::kScene, manifest_key::kName);
+  m.rig = NameOf(root, manifest_key::kRig, manifest_key::kName);
+  m.avatar = NameOf(root, manifest_key::kAvatar, manifest_key::kName);
+  m.motion = NameOf(root, manifest_key::kMotion, manifest_key::kName);
+  m.sensor = NameOf(root, manifest_key::kSensor, "preset");
   return m;
 }
 

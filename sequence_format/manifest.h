@@ -14,6 +14,22 @@ namespace irbench {
 inline constexpr char kManifestFile[] = "manifest.json";
 inline constexpr char kSequenceFormat[] = "irbench.sequence/1";
 
+// The keys both the writer (sim/sequence/render_job.cc) and the reader use.
+namespace manifest_key {
+inline constexpr char kFormat[] = "format";
+inline constexpr char kSeed[] = "seed";
+inline constexpr char kScene[] = "scene";
+inline constexpr char kRig[] = "rig";
+inline constexpr char kAvatar[] = "avatar";
+inline constexpr char kMotion[] = "motion";
+inline constexpr char kSensor[] = "sensor";  // the preset's name
+inline constexpr char kFps[] = "fps";
+inline constexpr char kFrameCount[] = "frame_count";
+inline constexpr char kCameras[] = "cameras";
+inline constexpr char kJoints[] = "joints";
+inline constexpr char kName[] = "name";  // of scene, rig, avatar, motion
+}  // namespace manifest_key
+
 // The fields the readers use, typed; `json` holds the whole file.
 struct Manifest {
   uint64_t seed = 0;

@@ -33,7 +33,7 @@ void ReadPlane(const JsonNode& s, ScreenSurface& screen) {
   if (screen.up.norm() < 1e-9) s["up"].Fail("must be non-zero");
   screen.right.normalize();
   screen.up.normalize();
-  if (std::abs(screen.right.dot(screen.up)) > 1e-6)
+  if (std::abs(screen.right.dot(screen.up)) > 1e-3)
     s["up"].Fail("must be perpendicular to 'right'");
   screen.width = s.GetDouble("width");
   screen.height = s.GetDouble("height");
@@ -41,12 +41,14 @@ void ReadPlane(const JsonNode& s, ScreenSurface& screen) {
   if (screen.height <= 0) s["height"].Fail("must be positive");
 }
 
-// Targets as [s, t] or {"screen": [s, t], ...}; each on the screen.
-void ReadTargets(const JsonNode& targets, ScreenSurface& screen) {
+// Targets as [s, t] or {"screen": [s, t], "world": ...}; each on the screen.
+void ReadTargets(const JsonNode& targets, TargetForm form, ScreenSurface& screen) {
   const Eigen::Vector2d size = screen.Size();
   for (const std::string& name : targets.Keys()) {
     const JsonNode target = targets[name];
-    const Eigen::Vector2d st = target.raw().is_object() ? target["screen"].Vec2() : target.Vec2();
+    if (form == TargetForm::kSurveyed) target.CheckKeys({"screen", "world"});
+    const Eigen::Vector2d st =
+        form == TargetForm::kSurveyed ? target["screen"].Vec2() : target.Vec2();
     if (st.x() < 0 || st.x() > size.x() || st.y() < 0 || st.y() > size.y()) {
       target.Fail("target outside the screen (size " + std::to_string(size.x()) + " x " +
                   std::to_string(size.y()) + " m)");
@@ -57,7 +59,9 @@ void ReadTargets(const JsonNode& targets, ScreenSurface& screen) {
 
 }  // namespace
 
-ScreenSurface ReadScreenSurface(const JsonNode& s, const std::vector<std::string>& allowed_keys) {
+ScreenSurface ReadScreenSurface(const JsonNode& s,
+                                TargetForm target_form,
+                                const std::vector<std::string>& allowed_keys) {
   ScreenSurface screen;
   screen.name = s.GetString("name");
   const std::string type = s.GetString("type");
@@ -75,7 +79,7 @@ ScreenSurface ReadScreenSurface(const JsonNode& s, const std::vector<std::string
   } else {
     s["type"].Fail("unknown screen type '" + type + "' (cylinder, plane)");
   }
-  if (s.Has("targets")) ReadTargets(s["targets"], screen);
+  if (s.Has("targets")) ReadTargets(s["targets"], target_form, screen);
   return screen;
 }
 
@@ -134,11 +138,12 @@ std::vector<ScreenSurface> ReadScreens(const std::filesystem::path& sequence_dir
   const JsonNode root = ParseJsonFile(path.string());
   if (root.GetString("format") != kScreensFormat)
     root["format"].Fail(std::string("expected \"") + kScreensFormat + "\"");
-  root.CheckKeys({"format", "scene", "screens"});
+  root.CheckKeys({"format", "scene", "screens", "description"});
   std::vector<ScreenSurface> out;
   const JsonNode list = root["screens"];
   for (size_t i = 0; i < list.Size(); ++i)
-    out.push_back(ReadScreenSurface(list[i], {"screen_frame", "size"}));
+    out.push_back(
+        ReadScreenSurface(list[i], TargetForm::kSurveyed, {"screen_frame", "size", "description"}));
   return out;
 }
 

@@ -18,11 +18,18 @@ namespace irbench {
 inline constexpr char kScreensFile[] = "calib/screens.json";
 inline constexpr char kScreensFormat[] = "irbench.screens/1";
 
-// A screen's name, type, geometry and targets from a JSON object. Targets are
-// [s, t] (a scene file) or {"screen": [s, t], ...} (calib/screens.json); each
-// must lie on the screen. `allowed_keys` are checked (CheckKeys) besides the
-// geometry's own. InputError names the field on any bad value.
-ScreenSurface ReadScreenSurface(const JsonNode& s, const std::vector<std::string>& allowed_keys);
+// How a file gives a screen's targets: [s, t] (a scene file) or
+// {"screen": [s, t], "world": [x, y, z]} (calib/screens.json, as surveyed).
+enum class TargetForm { kScreenCoordinates, kSurveyed };
+
+// A screen's name, type, geometry and targets from a JSON object: a plane's
+// `right` and `up` perpendicular (within 1e-3 after normalising: a survey's
+// accuracy), a cylinder's angles and heights increasing, every target on the
+// screen. `allowed_keys` are accepted (CheckKeys) besides the geometry's own.
+// InputError names the field on any bad value.
+ScreenSurface ReadScreenSurface(const JsonNode& s,
+                                TargetForm target_form,
+                                const std::vector<std::string>& allowed_keys);
 
 // One screen as calib/screens.json lists it: the geometry as in the scene
 // file, `screen_frame` (a sentence defining s and t), `size` and `targets`

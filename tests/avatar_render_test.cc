@@ -9,6 +9,7 @@
 
 #include "sim/body/avatar_import.h"
 #include "sim/sequence/render_job.h"
+#include "sequence_format/manifest.h"
 #include "tests/mask_check.h"
 #include "tests/test_util.h"
 
@@ -81,7 +82,7 @@ TEST(AvatarRenderTest, SharedAvatarsImportRenderAndKeepTruthOnTheirMasks) {
     // Wizard's ankles, which its rig puts at the boots' soles — can round
     // outward).
     EXPECT_LE(worst, 1.5) << a.file << ": " << worst_at;
-    const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+    const auto manifest = ReadManifest(seq).json;
     EXPECT_EQ(manifest["avatar"]["kind"], "mesh") << manifest["avatar"].dump();
     fs::remove_all(seq);
   }

@@ -13,6 +13,7 @@
 
 #include "sim/sensor/flicker.h"
 #include "sim/sequence/render_job.h"
+#include "sequence_format/manifest.h"
 #include "tests/test_util.h"
 
 namespace irbench {
@@ -105,7 +106,7 @@ TEST(IlluminationTest, EmptyStageFramesSweepTheScreens) {
     options.background_frames = 3;
     options.out = dir / sensor;
     const fs::path seq = RunRenderJob(options);
-    const nlohmann::json manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+    const nlohmann::json manifest = ReadManifest(seq).json;
     const std::vector<nlohmann::json> truth = ReadLines(seq / "truth/background.jsonl");
     ASSERT_EQ(truth.size(), 3u);
     const bool sweep = sensor != "clean";

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "sequence_format/manifest.h"
 #include "tests/test_util.h"
 
 namespace irbench::testing {
@@ -24,7 +25,7 @@ namespace irbench::testing {
 inline double WorstVisibleJointOffMask(const std::filesystem::path& seq, int* visible,
                                        std::string* worst_at = nullptr,
                                        std::map<std::string, double>* worst_per_joint = nullptr) {
-  const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+  const auto manifest = ReadManifest(seq).json;
   std::ifstream truth(seq / "truth/frames.jsonl");
   std::string line;
   double worst = 0;

@@ -13,6 +13,7 @@
 
 #include "sim/motion/retarget.h"
 #include "sim/sequence/render_job.h"
+#include "sequence_format/manifest.h"
 #include "tests/mask_check.h"
 #include "tests/test_util.h"
 
@@ -47,7 +48,7 @@ TEST(MotionRenderTest, EveryCmuClipRetargetsAndRenders) {
       const double worst = irbench::testing::WorstVisibleJointOffMask(seq, &visible);
       EXPECT_GT(visible, 10) << clip.filename() << " on " << person;
       EXPECT_LE(worst, 2.0) << clip.filename() << " on " << person;
-      const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+      const auto manifest = ReadManifest(seq).json;
       EXPECT_EQ(manifest["motion"]["kind"], "session");
       fs::remove_all(seq);
     }
@@ -90,7 +91,7 @@ TEST(MotionRenderTest, AsfAmcRetargetsAndRenders) {
   int visible = 0;
   EXPECT_LE(irbench::testing::WorstVisibleJointOffMask(seq, &visible), 2.0);
   EXPECT_GT(visible, 10);
-  const auto manifest = nlohmann::json::parse(ReadText(seq / "manifest.json"));
+  const auto manifest = ReadManifest(seq).json;
   EXPECT_EQ(manifest["motion"]["kind"], "amc");
 }
 

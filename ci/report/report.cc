@@ -151,8 +151,8 @@ std::string Describe(const fs::path& sequence) {
   Manifest m;
   try {
     m = ReadManifest(sequence);
-  } catch (const InputError&) {
-    return "";  // the heading goes without (another tool's folder)
+  } catch (const std::exception&) {
+    return "";  // the heading goes without (another tool's folder, an unreadable file)
   }
   std::ostringstream out;
   for (const auto& [key, v] : {std::pair<const char*, const std::string&>{"scene", m.scene},

@@ -57,13 +57,19 @@ std::string KnownMetricsText() {
   return out;
 }
 
-// A scenario's `track` object: any setting of TrackSettings() by its key.
-void ReadTrackerSettings(const JsonNode& t, TrackerSettings& settings) {
+// A scenario's `track` object: any setting of TrackSettings() by its key; a
+// relative path (rest_model) is relative to the suite file's folder.
+void ReadTrackerSettings(const JsonNode& t, const fs::path& suite_file, TrackerSettings& settings) {
   std::vector<std::string> keys;
   for (const TrackSetting& setting : TrackSettings()) keys.push_back(setting.key);
   t.CheckKeys(keys);
   for (const TrackSetting& setting : TrackSettings()) {
-    if (t.Has(setting.key)) SetFromJson(setting, t[setting.key], settings);
+    if (!t.Has(setting.key)) continue;
+    SetFromJson(setting, t[setting.key], settings);
+    if (const auto* path = std::get_if<PathBinding>(&setting.binding)) {
+      fs::path& value = path->ref(settings);
+      if (!value.empty() && value.is_relative()) value = suite_file.parent_path() / value;
+    }
   }
 }
 
@@ -97,7 +103,7 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
     sc.render.background_frames = s.GetInt("background_frames", 12);
     if (sc.render.background_frames < 2) s["background_frames"].Fail("the tracker needs at least 2");
     sc.render.screen_sweep = s.GetBool("background_screen_sweep", true);
-    if (s.Has("track")) ReadTrackerSettings(s["track"], sc.tracker);
+    if (s.Has("track")) ReadTrackerSettings(s["track"], file, sc.tracker);
     const JsonNode th = s["thresholds"];
     for (const auto& [metric, value] : th.raw().items()) {
       if (std::find(KnownMetrics().begin(), KnownMetrics().end(), metric) == KnownMetrics().end()) {

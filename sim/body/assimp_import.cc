@@ -14,8 +14,8 @@
 #include <set>
 
 #include "common/error.h"
-#include "sim/body/internal/joint_naming.h"
 #include "sim/body/internal/imported_rig.h"
+#include "sim/body/internal/joint_naming.h"
 
 namespace irbench::import_internal {
 namespace {

@@ -337,10 +337,9 @@ Avatar LoadMeshAvatar(const std::filesystem::path& path, const JsonNode& root, c
     options.scale = root.GetDouble("scale");
     if (!(options.scale > 0 && options.scale <= 1000)) root["scale"].Fail("must be in (0, 1000] metres per file unit");
   }
-  options.up_axis = root.GetString("up_axis", "auto");
-  if (options.up_axis != "auto" && options.up_axis != "y" && options.up_axis != "z") {
-    root["up_axis"].Fail("must be auto, y or z");
-  }
+  const std::optional<UpAxis> up_axis = ParseUpAxis(root.GetString("up_axis", "auto"));
+  if (!up_axis) root["up_axis"].Fail("must be auto, y or z");
+  options.up_axis = *up_axis;
   if (root.Has("joint_map")) {
     const JsonNode m = root["joint_map"];
     if (!m.raw().is_object()) m.Fail("must be an object: canonical joint name -> rig joint name");

@@ -255,12 +255,12 @@ Matrix3d UpRotation(const Rig& rig,
                     std::string& up_used) {
   auto rp = [&](int j) { return rig.joint_bind[rig_of[j]]; };
   Matrix3d up_rotation = Matrix3d::Identity();
-  if (options.up_axis == "z") {
+  if (options.up_axis == UpAxis::kZ) {
     up_used = "z";
-  } else if (options.up_axis == "y") {
+  } else if (options.up_axis == UpAxis::kY) {
     up_rotation = Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitX()).toRotationMatrix();
     up_used = "y";
-  } else if (options.up_axis == "auto" || options.up_axis.empty()) {
+  } else {
     const Vector3d d = rp(kHead) - rp(kPelvis);
     if (d.norm() < 1e-9) throw InputError(file, "skin", "the pelvis and head joints coincide");
     int axis = 0;
@@ -272,8 +272,6 @@ Matrix3d UpRotation(const Rig& rig,
             ? Eigen::AngleAxisd(M_PI, Vector3d::UnitX()).toRotationMatrix()
             : Eigen::Quaterniond::FromTwoVectors(up, Vector3d::UnitZ()).toRotationMatrix();
     up_used = std::string(d[axis] > 0 ? "+" : "-") + "xyz"[axis] + " (auto)";
-  } else {
-    throw InputError(file, "up_axis", "must be auto, y or z, not '" + options.up_axis + "'");
   }
   return up_rotation;
 }
@@ -782,6 +780,13 @@ Avatar ImportRiggedAvatar(const std::filesystem::path& file, const ImportOptions
                                        ? import_internal::LoadGltf(file)
                                        : import_internal::LoadAssimp(file);
   return import_internal::BuildAvatar(rig, file, options);
+}
+
+std::optional<UpAxis> ParseUpAxis(const std::string& name) {
+  if (name == "auto") return UpAxis::kAuto;
+  if (name == "y") return UpAxis::kY;
+  if (name == "z") return UpAxis::kZ;
+  return std::nullopt;
 }
 
 }  // namespace irbench

@@ -12,12 +12,18 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sim/body/avatar.h"
 
 namespace irbench {
+
+// A rigged mesh's up axis as the avatar file names it ("auto", "y", "z").
+enum class UpAxis { kAuto, kY, kZ };
+// "auto", "y" or "z"; nullopt for another name.
+std::optional<UpAxis> ParseUpAxis(const std::string& name);
 
 struct ImportOptions {
   std::string name;  // default: the file's stem
@@ -28,8 +34,8 @@ struct ImportOptions {
   // metadata, else centimetres are tried when the height is implausible.
   double scale = 0;
   // The file's up axis in its world frame (glTF: after the node transforms):
-  // "auto" (the axis nearest to pelvis -> head), "y" or "z".
-  std::string up_axis = "auto";
+  // auto (the axis nearest to pelvis -> head), y or z.
+  UpAxis up_axis = UpAxis::kAuto;
 };
 
 // Canonical joint name -> rig joint name (the rig's own spelling), from the
@@ -53,7 +59,7 @@ JointMapping MapRigJoints(const std::vector<std::string>& rig_joint_names,
 // Imports `file` (.gltf/.glb, or anything assimp reads that has a skinned
 // mesh). Throws InputError(file, field, ...): "file" (missing, unreadable,
 // corrupt), "skin" (no skinned mesh, no arm/torso/leg chain), "height" (outside
-// 1.0..2.3 m after scaling), "scale" / "up_axis" / "joint_map.*" (bad options).
+// 1.0..2.3 m after scaling), "scale" / "joint_map.*" (bad options).
 Avatar ImportRiggedAvatar(const std::filesystem::path& file, const ImportOptions& options = {});
 
 }  // namespace irbench

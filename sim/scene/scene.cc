@@ -23,7 +23,7 @@ void CheckBox(const JsonNode& node, const Eigen::Vector3d& min, const Eigen::Vec
 // A scene file's screen: its surface (sequence_format/screens.h, shared with
 // calib/screens.json) and how it renders.
 ScreenSurface ReadScreen(const JsonNode& s, Material* material) {
-  ScreenSurface screen = ReadScreenSurface(s, {"albedo", "content_radiance", "description"});
+  ScreenSurface screen = ReadScreenSurface(s, TargetForm::kScreenCoordinates, {"albedo", "content_radiance", "description"});
   *material = ReadMaterial(s, "albedo", 0.8f);
   // The near-IR radiance the projected content adds (projectors leak near IR);
   // it flickers with the content (docs/sensor.md).

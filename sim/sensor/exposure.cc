@@ -2,8 +2,12 @@
 
 namespace irbench {
 
-RigExposure::CameraChain::CameraChain(const Camera& camera, const SensorSetup& camera_setup, bool is_active,
-                                      uint64_t seed, double start_s, double end_s)
+RigExposure::CameraChain::CameraChain(const Camera& camera,
+                                      const SensorSetup& camera_setup,
+                                      bool is_active,
+                                      uint64_t seed,
+                                      double start_s,
+                                      double end_s)
     : name(camera.name),
       exposure_ms(camera.exposure_ms),
       setup(camera_setup),
@@ -35,8 +39,11 @@ cv::Mat RigExposure::Expose(size_t c,
                             double sweep) {
   CameraChain& chain = chains_[c];
   if (!chain.active) {
-    sensor_truth[chain.name] = {{"flicker", 1.0}, {"screen", 1.0}, {"illuminators", 1.0},
-                                {"exposure_ms", chain.exposure_ms}, {"dropped", false}};
+    sensor_truth[chain.name] = {{"flicker", 1.0},
+                                {"screen", 1.0},
+                                {"illuminators", 1.0},
+                                {"exposure_ms", chain.exposure_ms},
+                                {"dropped", false}};
     return render.grey;
   }
   const SensorSetup& setup = chain.setup;
@@ -50,14 +57,18 @@ cv::Mat RigExposure::Expose(size_t c,
   const bool dropped = drop_u < setup.capture.drop_rate && !chain.last_written.empty();
   nlohmann::json& truth = sensor_truth[chain.name];
   // A dropped frame repeats the last image, and its illumination.
-  truth = {{"flicker", chain.last_flicker}, {"screen", screen}, {"illuminators", mains},
-           {"exposure_ms", chain.exposure_ms}, {"dropped", dropped}};
+  truth = {{"flicker", chain.last_flicker},
+           {"screen", screen},
+           {"illuminators", mains},
+           {"exposure_ms", chain.exposure_ms},
+           {"dropped", dropped}};
   if (dropped) return chain.last_written;
   const cv::Mat sources = samples > 1 ? cv::Mat(radiance_sum / samples) : render.radiance;
   chain.last_flicker = WeighSources(chain, sources, start_s, exposure_s, mains, screen, sweep);
   truth["flicker"] = chain.last_flicker;
   const cv::Mat seen = chain.optics.Apply(radiance_, render.depth);
-  chain.last_written = chain.sensor.ToOutput(chain.sensor.Expose(seen, chain.exposure_ms, noise_frame));
+  chain.last_written =
+      chain.sensor.ToOutput(chain.sensor.Expose(seen, chain.exposure_ms, noise_frame));
   return chain.last_written;
 }
 
@@ -86,7 +97,8 @@ double RigExposure::WeighSources(const CameraChain& chain,
     for (int y = 0; y < sources.rows; ++y) {
       const double row_start = start_s + (double(y) / (sources.rows - 1) - 0.5) * readout_s;
       const float m = static_cast<float>(chain.flicker.MainsMean(row_start, exposure_s));
-      const float s = static_cast<float>(sweep >= 0 ? sweep : chain.flicker.ScreenMean(row_start, exposure_s));
+      const float s =
+          static_cast<float>(sweep >= 0 ? sweep : chain.flicker.ScreenMean(row_start, exposure_s));
       const cv::Vec4f* in_row = sources.ptr<cv::Vec4f>(y);
       float* out_row = radiance_.ptr<float>(y);
       double row_sum = 0;

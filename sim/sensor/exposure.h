@@ -65,8 +65,12 @@ class RigExposure {
  private:
   // One camera's chain and the state a dropped frame repeats.
   struct CameraChain {
-    CameraChain(const Camera& camera, const SensorSetup& camera_setup, bool is_active, uint64_t seed,
-                double start_s, double end_s);
+    CameraChain(const Camera& camera,
+                const SensorSetup& camera_setup,
+                bool is_active,
+                uint64_t seed,
+                double start_s,
+                double end_s);
     std::string name;
     double exposure_ms;
     SensorSetup setup;

@@ -1,6 +1,3 @@
-#include "sequence_format/calibration.h"
-#include "sequence_format/manifest.h"
-#include "sequence_format/screens.h"
 #include "sim/sequence/render_job.h"
 
 #include <algorithm>
@@ -13,9 +10,12 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "common/paths.h"
-#include "sim/sequence/image_io.h"
+#include "sequence_format/calibration.h"
+#include "sequence_format/manifest.h"
+#include "sequence_format/screens.h"
 #include "sim/motion/bvh.h"
 #include "sim/sensor/exposure.h"
+#include "sim/sequence/image_io.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -202,21 +202,21 @@ nlohmann::json BuildManifest(const RenderJobOptions& options,
                              const GlContext& context,
                              const RenderOptions& render_options) {
   nlohmann::json manifest;
-  manifest["format"] = "irbench.sequence/1";
+  manifest[manifest_key::kFormat] = kSequenceFormat;
   manifest["tool_version"] = ToolVersion();
-  manifest["seed"] = options.seed;
-  manifest["scene"] = {{"name", in.scene.name}, {"file", in.scene_file.filename().string()}};
-  manifest["rig"] = {{"name", in.rig.name}, {"file", in.rig_file.filename().string()}};
-  manifest["avatar"] = {{"name", in.avatar.params.name},
+  manifest[manifest_key::kSeed] = options.seed;
+  manifest[manifest_key::kScene] = {{manifest_key::kName, in.scene.name}, {"file", in.scene_file.filename().string()}};
+  manifest[manifest_key::kRig] = {{manifest_key::kName, in.rig.name}, {"file", in.rig_file.filename().string()}};
+  manifest[manifest_key::kAvatar] = {{manifest_key::kName, in.avatar.params.name},
                         {"file", in.avatar_file.filename().string()},
                         {"kind", in.avatar.params.kind},
                         {"build", in.avatar.params.build}};
   if (in.avatar.params.source.is_object()) {  // imported mesh: how its rig was read
     nlohmann::json source = in.avatar.params.source;
     source["file"] = fs::path(source["file"].get<std::string>()).filename().string();
-    manifest["avatar"]["source"] = source;
+    manifest[manifest_key::kAvatar]["source"] = source;
   }
-  manifest["motion"] = {{"name", in.motion_name},
+  manifest[manifest_key::kMotion] = {{manifest_key::kName, in.motion_name},
                         {"file", in.motion_file.empty() ? nlohmann::json(nullptr)
                                                         : nlohmann::json(in.motion_file.filename().string())},
                         {"kind", in.motion_kind},
@@ -227,17 +227,17 @@ nlohmann::json BuildManifest(const RenderJobOptions& options,
                                    {"tremor_deg", in.style.tremor_deg},
                                    {"tremor_hz", in.style.tremor_hz},
                                    {"handedness", in.style.handedness > 0 ? "right" : "left"}}}};
-  manifest["sensor"] = options.sensor;
-  manifest["fps"] = in.fps;
-  manifest["frame_count"] = in.frame_count;
+  manifest[manifest_key::kSensor] = options.sensor;
+  manifest[manifest_key::kFps] = in.fps;
+  manifest[manifest_key::kFrameCount] = in.frame_count;
   manifest["background_frame_count"] = options.background_frames;
   manifest["background_screen_sweep"] =
       sweep_screens ? nlohmann::json{{"from", kSweepLow}, {"to", kSweepHigh}} : nlohmann::json(nullptr);
   nlohmann::json camera_names = nlohmann::json::array();
   for (const Camera& cam : in.rig.cameras) camera_names.push_back(cam.name);
-  manifest["cameras"] = camera_names;
+  manifest[manifest_key::kCameras] = camera_names;
   manifest["body_height_m"] = in.avatar.params.height_m;
-  manifest["joints"] = TruthJointNames();
+  manifest[manifest_key::kJoints] = TruthJointNames();
   manifest["depth"] = options.write_depth;
   manifest["renderer"] = {{"backend", context.BackendName()},
                           {"gl", context.RendererString()},

@@ -62,16 +62,16 @@ void Offset(std::vector<Eigen::Vector2d>& loop, double d, bool hole) {
 }  // namespace
 
 void PolygonOptions::Check() const {
-  if (epsilon_px < 0) throw InputError("", "epsilon_px", "must be >= 0 (0: adaptive)");
+  if (epsilon_px < 0) throw InputError("", "polygons.epsilon_px", "must be >= 0 (0: adaptive)");
   if (min_edges < 3 || max_edges < min_edges)
-    throw InputError("", "min_edges", "need 3 <= min_edges <= max_edges");
+    throw InputError("", "polygons.min_edges", "need 3 <= min_edges <= max_edges");
   if (min_epsilon_px <= 0 || max_epsilon_px < min_epsilon_px) {
-    throw InputError("", "min_epsilon_px", "need 0 < min_epsilon_px <= max_epsilon_px");
+    throw InputError("", "polygons.min_epsilon_px", "need 0 < min_epsilon_px <= max_epsilon_px");
   }
   if (min_blob_area_px < 0 || min_hole_area_px < 0)
-    throw InputError("", "min_blob_area_px", "must be >= 0");
+    throw InputError("", "polygons.min_blob_area_px", "must be >= 0");
   if (outward_offset_px < 0 || outward_offset_px > 5)
-    throw InputError("", "outward_offset_px", "must be in [0, 5]");
+    throw InputError("", "polygons.outward_offset_px", "must be in [0, 5]");
 }
 
 int SilhouettePolygons::EdgeCount() const {

@@ -361,14 +361,14 @@ void DropUnusedVertices(HullMesh& mesh) {
 void PolyhedralHullOptions::Check() const {
   for (int a = 0; a < 3; ++a) {
     if (!(max_corner_m[a] > min_corner_m[a]))
-      throw InputError("", "max_corner_m", "must exceed min_corner_m on every axis");
+      throw InputError("", "polyhedral.max_corner_m", "must exceed min_corner_m on every axis");
   }
-  if (!(ray_step_px > 0)) throw InputError("", "ray_step_px", "must be > 0");
-  if (max_rays_per_edge < 1) throw InputError("", "max_rays_per_edge", "must be >= 1");
-  if (!(near_m > 0)) throw InputError("", "near_m", "must be > 0");
-  if (!(max_chord_error_m > 0)) throw InputError("", "max_chord_error_m", "must be > 0");
+  if (!(ray_step_px > 0)) throw InputError("", "polyhedral.ray_step_px", "must be > 0");
+  if (max_rays_per_edge < 1) throw InputError("", "polyhedral.max_rays_per_edge", "must be >= 1");
+  if (!(near_m > 0)) throw InputError("", "polyhedral.near_m", "must be > 0");
+  if (!(max_chord_error_m > 0)) throw InputError("", "polyhedral.max_chord_error_m", "must be > 0");
   if (max_refinement < 0 || max_refinement > 20)
-    throw InputError("", "max_refinement", "must be in 0..20");
+    throw InputError("", "polyhedral.max_refinement", "must be in 0..20");
 }
 
 double MeshVolume(const HullMesh& mesh) {

@@ -17,25 +17,25 @@
 namespace irbench {
 
 void VoxelGridOptions::Check() const {
-  if (!(voxel_size_m > 0)) throw InputError("", "voxel_size_m", "must be > 0");
-  if (max_missing_views < 0 || max_missing_views > 8) throw InputError("", "max_missing_views", "must be in 0..8");
+  if (!(voxel_size_m > 0)) throw InputError("", "voxels.voxel_size_m", "must be > 0");
+  if (max_missing_views < 0 || max_missing_views > 8) throw InputError("", "voxels.max_missing_views", "must be in 0..8");
   for (int a = 0; a < 3; ++a) {
     if (!(max_corner_m[a] > min_corner_m[a]))
-      throw InputError("", "max_corner_m", "must exceed min_corner_m on every axis");
+      throw InputError("", "voxels.max_corner_m", "must exceed min_corner_m on every axis");
   }
   const Eigen::Vector3d n = (max_corner_m - min_corner_m) / voxel_size_m;
   if (n.x() * n.y() * n.z() > 4.0e8)
-    throw InputError("", "voxel_size_m", "grid too large (over 4e8 voxels)");
-  if (margin_px < 0 || margin_px > 100) throw InputError("", "margin_px", "must be in [0, 100]");
+    throw InputError("", "voxels.voxel_size_m", "grid too large (over 4e8 voxels)");
+  if (margin_px < 0 || margin_px > 100) throw InputError("", "voxels.margin_px", "must be in [0, 100]");
   if (footprint_scale < 0 || footprint_scale > 4)
-    throw InputError("", "footprint_scale", "must be in [0, 4]");
-  if (min_observing_cameras < 1) throw InputError("", "min_observing_cameras", "must be >= 1");
+    throw InputError("", "voxels.footprint_scale", "must be in [0, 4]");
+  if (min_observing_cameras < 1) throw InputError("", "voxels.min_observing_cameras", "must be >= 1");
   if (max_missing_views >= min_observing_cameras) {
     // Else a voxel seen by just min_observing_cameras cameras could never be carved.
-    throw InputError("", "max_missing_views", "must be below min_observing_cameras (" +
+    throw InputError("", "voxels.max_missing_views", "must be below min_observing_cameras (" +
                                                   std::to_string(min_observing_cameras) + ")");
   }
-  if (!(near_m > 0)) throw InputError("", "near_m", "must be > 0");
+  if (!(near_m > 0)) throw InputError("", "voxels.near_m", "must be > 0");
 }
 
 bool VoxelHull::ContainsPoint(const Eigen::Vector3d& p_in_world) const {

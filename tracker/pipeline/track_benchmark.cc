@@ -21,7 +21,9 @@ struct FrontEndSamples {
 };
 
 // Milliseconds of the stages irbench track runs (all but the polyhedral hull).
-double TrackedMs(const FrameFeatures& f) { return f.ms_silhouettes + f.ms_axes + f.ms_polygons + f.ms_voxels; }
+double TrackedMs(const FrameFeatures& f) {
+  return f.ms_silhouettes + f.ms_axes + f.ms_polygons + f.ms_voxels;
+}
 
 // The median and mean of `samples_ms` as the row of `stage`.
 TrackBenchRow SummaryRow(const std::string& stage, std::vector<double> samples_ms) {
@@ -49,7 +51,8 @@ std::vector<FrameFeatures> TimeFrontEnd(const FrontEnd& front_end,
       const auto start = std::chrono::steady_clock::now();
       FrameFeatures features = front_end.Process(f, images[f]);
       samples->total.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
       samples->silhouettes.push_back(features.ms_silhouettes);
       samples->axes.push_back(features.ms_axes);
       samples->polygons.push_back(features.ms_polygons);
@@ -81,14 +84,16 @@ std::vector<double> TimeFrontEndOneThread(const FrontEnd& front_end,
 
 // The front end's rows, in the order the table prints them.
 std::vector<TrackBenchRow> FrontEndRows(const FrontEndSamples& s) {
-  return {SummaryRow("silhouettes (background model, morphology, shadow removal)", s.silhouettes),
-          SummaryRow("2D axis points, body parts, 3D axis points", s.axes),
-          SummaryRow("silhouette polygons", s.polygons),
-          SummaryRow("voxel hull (2 cm, look-up table)", s.voxels),
-          SummaryRow("polyhedral hull (on request)", s.polyhedral),
-          SummaryRow("front end as irbench track runs it (the stages above but the polyhedral hull)", s.tracked),
-          SummaryRow("the same on one thread", s.one_thread),
-          SummaryRow("front end, all stages (polyhedral hull included)", s.total)};
+  return {
+      SummaryRow("silhouettes (background model, morphology, shadow removal)", s.silhouettes),
+      SummaryRow("2D axis points, body parts, 3D axis points", s.axes),
+      SummaryRow("silhouette polygons", s.polygons),
+      SummaryRow("voxel hull (2 cm, look-up table)", s.voxels),
+      SummaryRow("polyhedral hull (on request)", s.polyhedral),
+      SummaryRow("front end as irbench track runs it (the stages above but the polyhedral hull)",
+                 s.tracked),
+      SummaryRow("the same on one thread", s.one_thread),
+      SummaryRow("front end, all stages (polyhedral hull included)", s.total)};
 }
 
 // The shipped rest-state classifier, as irbench track runs it, where the data
@@ -123,7 +128,8 @@ std::vector<double> TimePoseTracker(const SequenceInput& input,
   return pose_ms;
 }
 
-// The pose tracker's rows (thesis 6.3) against particle count; a count where it never tracks has none.
+// The pose tracker's rows (thesis 6.3) against particle count; a count where it never tracks has
+// none.
 std::vector<TrackBenchRow> PoseRows(const SequenceInput& input,
                                     const std::vector<FrameFeatures>& all_features,
                                     int repeats) {
@@ -132,8 +138,9 @@ std::vector<TrackBenchRow> PoseRows(const SequenceInput& input,
   for (int particles : {25, 50, 100, 200, 400}) {
     std::vector<double> pose_ms = TimePoseTracker(input, all_features, rest, particles, repeats);
     if (pose_ms.empty()) continue;
-    rows.push_back(SummaryRow("pose tracker, " + std::to_string(particles) + " particles (20% refined by ICP" +
-                                  (rest ? ", rest state" : "") + ")",
+    rows.push_back(SummaryRow("pose tracker, " + std::to_string(particles) +
+                                  " particles (20% refined by ICP" + (rest ? ", rest state" : "") +
+                                  ")",
                               std::move(pose_ms)));
   }
   return rows;
@@ -149,7 +156,8 @@ std::vector<TrackBenchRow> RunTrackBenchmark(const fs::path& sequence, int repea
   const FrontEnd front_end = FrontEnd::Train(input, options);
   const std::vector<std::vector<cv::Mat>> images = PreloadFrameSets(input);
   FrontEndSamples samples;
-  const std::vector<FrameFeatures> all_features = TimeFrontEnd(front_end, images, repeats, &samples);
+  const std::vector<FrameFeatures> all_features =
+      TimeFrontEnd(front_end, images, repeats, &samples);
   samples.one_thread = TimeFrontEndOneThread(front_end, images, repeats);
   std::vector<TrackBenchRow> rows = FrontEndRows(samples);
   for (TrackBenchRow& row : PoseRows(input, all_features, repeats)) rows.push_back(std::move(row));

@@ -20,6 +20,8 @@ struct TrackBenchRow {
 // OpenCV's threads and on one), then the pose tracker (thesis 6.3) at 25 to
 // 400 particles on the same features. `sequence` is a folder written by
 // render, with empty-stage frames. Sets *cameras to its camera count.
-std::vector<TrackBenchRow> RunTrackBenchmark(const std::filesystem::path& sequence, int repeats, int* cameras);
+std::vector<TrackBenchRow> RunTrackBenchmark(const std::filesystem::path& sequence,
+                                             int repeats,
+                                             int* cameras);
 
 }  // namespace irbench

@@ -98,7 +98,7 @@ const TrackSetting* FindTrackSetting(const std::string& key) {
 }
 
 nlohmann::json SettingValue(const TrackSetting& setting, const TrackerSettings& settings) {
-  TrackerSettings& t = const_cast<TrackerSettings&>(settings);  // the refs only read here
+  TrackerSettings t = settings;  // the bindings give mutable references; read a copy
   return std::visit(
       [&](const auto& b) -> nlohmann::json {
         using B = std::decay_t<decltype(b)>;
@@ -114,7 +114,7 @@ nlohmann::json SettingValue(const TrackSetting& setting, const TrackerSettings& 
 }
 
 std::string SettingProblem(const TrackSetting& setting, const TrackerSettings& settings) {
-  TrackerSettings& t = const_cast<TrackerSettings&>(settings);  // the refs only read here
+  TrackerSettings t = settings;  // the bindings give mutable references; read a copy
   return std::visit(
       [&](const auto& b) -> std::string {
         using B = std::decay_t<decltype(b)>;
@@ -244,7 +244,16 @@ std::string NonDefaultSettingsTag(const TrackerSettings& settings) {
   for (const TrackSetting& s : TrackSettings()) {
     const nlohmann::json value = SettingValue(s, settings);
     if (value == SettingValue(s, defaults)) continue;
-    tag += (tag.empty() ? "" : "-") + s.key + "=" + ValueText(value);
+    std::string text = ValueText(value);
+    if (std::holds_alternative<PathBinding>(s.binding)) {
+      // A path: its file name and a hash of the whole, to keep the tag short.
+      uint32_t hash = 2166136261u;  // FNV-1a
+      for (unsigned char c : text) hash = (hash ^ c) * 16777619u;
+      char hex[16];
+      std::snprintf(hex, sizeof(hex), "%08x", hash);
+      text = std::filesystem::path(text).stem().string().substr(0, 32) + "_" + hex;
+    }
+    tag += (tag.empty() ? "" : "-") + s.key + "=" + text;
   }
   for (char& c : tag) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '=' && c != '-' &&

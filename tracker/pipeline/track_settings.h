@@ -14,6 +14,7 @@
 #include <variant>
 #include <vector>
 
+#include "common/json_reader.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/pose/pose_tracker.h"
 
@@ -83,13 +84,11 @@ nlohmann::json SettingValue(const TrackSetting& setting, const TrackerSettings& 
 std::string SettingProblem(const TrackSetting& setting, const TrackerSettings& settings);
 // Sets the setting from a JSON value; InputError (naming `node`'s file and
 // field) on a wrong type, an unknown choice or a value out of range.
-void SetFromJson(const TrackSetting& setting,
-                 const class JsonNode& node,
-                 TrackerSettings& settings);
+void SetFromJson(const TrackSetting& setting, const JsonNode& node, TrackerSettings& settings);
 // Sets the setting from text as typed on a command line ("100", "pose");
 // InputError naming the flag when it does not parse or is out of range.
 void SetFromText(const TrackSetting& setting, const std::string& text, TrackerSettings& settings);
-// The setting's default as text (for --help).
+// The setting's default as text (for --help; "" for an empty path).
 std::string DefaultText(const TrackSetting& setting);
 // "INT", "UINT", "FLOAT", "TEXT", "PATH" or "" for a flag.
 std::string TypeName(const TrackSetting& setting);

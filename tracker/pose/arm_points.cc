@@ -32,8 +32,10 @@ ArmChains ChainArmPoints(const std::vector<AxisPoint3d>& axis3d, double link_m) 
   return out;
 }
 
-std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<Vector3d>& points, const std::vector<int>& chain,
-                                                     int chains, const Vector3d& right_shoulder,
+std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<Vector3d>& points,
+                                                     const std::vector<int>& chain,
+                                                     int chains,
+                                                     const Vector3d& right_shoulder,
                                                      const Vector3d& left_shoulder) {
   const int n = static_cast<int>(points.size());
   std::array<std::vector<Vector3d>, 2> out;
@@ -52,7 +54,8 @@ std::array<std::vector<Vector3d>, 2> ArmPointsBySide(const std::vector<Vector3d>
   return out;
 }
 
-std::optional<Vector3d> FarthestArmPoint(const std::vector<Vector3d>& points, const Vector3d& shoulder) {
+std::optional<Vector3d> FarthestArmPoint(const std::vector<Vector3d>& points,
+                                         const Vector3d& shoulder) {
   std::optional<Vector3d> farthest;
   double farthest_d = kArmApartM;
   for (const Vector3d& p : points) {

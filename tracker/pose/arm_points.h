@@ -27,10 +27,12 @@ ArmChains ChainArmPoints(const std::vector<AxisPoint3d>& axis3d, double link_m =
 // The chains' points by side (right, left): each chain belongs to the
 // shoulder (world, metres) nearest its nearest point, so an arm reaching
 // across the body stays with the shoulder it starts from.
-std::array<std::vector<Eigen::Vector3d>, 2> ArmPointsBySide(const std::vector<Eigen::Vector3d>& points,
-                                                            const std::vector<int>& chain, int chains,
-                                                            const Eigen::Vector3d& right_shoulder,
-                                                            const Eigen::Vector3d& left_shoulder);
+std::array<std::vector<Eigen::Vector3d>, 2> ArmPointsBySide(
+    const std::vector<Eigen::Vector3d>& points,
+    const std::vector<int>& chain,
+    int chains,
+    const Eigen::Vector3d& right_shoulder,
+    const Eigen::Vector3d& left_shoulder);
 
 // Arm axis points farther than this (metres) from the shoulder show the arm
 // apart from the body.

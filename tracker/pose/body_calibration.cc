@@ -44,11 +44,15 @@ std::optional<double> BodyCalibration::MatchHullTop(double top_m, BodyShape* sha
 // cm, arm joints 3.58 -> 3.35). The girth is searched against the
 // silhouettes. The particles keep their angles and move their waist
 // heights with the scale.
-std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking, const BodyPose& estimate, double top_m,
-                                                             const ShapeScore& score, BodyShape* shape) {
+std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking,
+                                                             const BodyPose& estimate,
+                                                             double top_m,
+                                                             const ShapeScore& score,
+                                                             BodyShape* shape) {
   const PosedBody body = PoseBody(*shape, estimate);
-  const bool arms_low = body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
-                        body.joints[kModelLeftHandTip].z() < body.joints[kModelLeftShoulder].z();
+  const bool arms_low =
+      body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
+      body.joints[kModelLeftHandTip].z() < body.joints[kModelLeftShoulder].z();
   if (tracking && arms_low && static_cast<int>(heights_.size()) < options_.height_frames) {
     // Searched with the torso and head upright: a twisted torso is how a
     // too-narrow model covers a wide body. The girth reaches 2.4: capped
@@ -58,7 +62,8 @@ std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking, cons
     const double top_height = std::clamp(top_m, 1.2, 2.2);
     double best_ll = -std::numeric_limits<double>::infinity(), best_girth = 1.0;
     BodyPose upright = estimate;
-    for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) upright.dof[d] = 0;
+    for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith})
+      upright.dof[d] = 0;
     upright.dof[kDofZ] *= top_height / shape->height_m;
     for (double girth : {0.9, 1.05, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.2, 2.4}) {
       const double ll = score(ShapeFor(top_height, girth), upright);
@@ -83,7 +88,8 @@ std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking, cons
 // The 3D arm axis points measure the arms across; the girth, measured on
 // the torso, does not tell a jacket from a broad chest. Kept in metres, so
 // that a height measured later scales the thickness.
-void BodyCalibration::MeasureArmThickness(bool tracking, const std::vector<double>& arm_diameters_m,
+void BodyCalibration::MeasureArmThickness(bool tracking,
+                                          const std::vector<double>& arm_diameters_m,
                                           BodyShape* shape) {
   if (tracking && arm_frames_ < options_.arm_thickness_frames && !arm_diameters_m.empty()) {
     arm_diameters_.insert(arm_diameters_.end(), arm_diameters_m.begin(), arm_diameters_m.end());
@@ -98,7 +104,8 @@ void BodyCalibration::MeasureArmThickness(bool tracking, const std::vector<doubl
 BodyShape BodyCalibration::ShapeFor(double height_m, double girth) const {
   const double thickness =
       arm_diameter_m_ > 0
-          ? std::clamp(arm_diameter_m_ / (options_.arm_reference_diameter * height_m), 1.0, options_.max_arm_thickness)
+          ? std::clamp(arm_diameter_m_ / (options_.arm_reference_diameter * height_m), 1.0,
+                       options_.max_arm_thickness)
           : 1.0;
   return BodyShape::FromHeight(height_m, girth, thickness);
 }

@@ -47,14 +47,19 @@ class BodyCalibration {
   // estimate's arms are below its shoulders, over the first height_frames
   // such frames. Updates `shape` to the medians and returns the ratio by
   // which the waist heights scale; nullopt when nothing was measured.
-  std::optional<double> MeasureHeightAndGirth(bool tracking, const BodyPose& estimate, double top_m,
-                                              const ShapeScore& score, BodyShape* shape);
+  std::optional<double> MeasureHeightAndGirth(bool tracking,
+                                              const BodyPose& estimate,
+                                              double top_m,
+                                              const ShapeScore& score,
+                                              BodyShape* shape);
 
   // The arms' thickness from this frame's 3D arm axis points' diameters
   // `arm_diameters_m` (metres) while `tracking`, over the first
   // arm_thickness_frames frames that have them; `shape` rescaled once
   // arm_thickness_min_points are in.
-  void MeasureArmThickness(bool tracking, const std::vector<double>& arm_diameters_m, BodyShape* shape);
+  void MeasureArmThickness(bool tracking,
+                           const std::vector<double>& arm_diameters_m,
+                           BodyShape* shape);
 
   // The model for a height (metres) and girth, its arms as thick as measured.
   BodyShape ShapeFor(double height_m, double girth) const;

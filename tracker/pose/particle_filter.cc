@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <optional>
 #include <opencv2/core/utility.hpp>
+#include <optional>
 #include <utility>
 
 namespace irbench {
@@ -16,7 +16,9 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-bool IsAngleDof(int d) { return d >= kDofYaw; }
+bool IsAngleDof(int d) {
+  return d >= kDofYaw;
+}
 
 // Places the body so that its root lands on `root_xy`.
 void PlaceRoot(const BodyShape& shape, BodyPose* pose, const Vector2d& root_xy) {
@@ -32,9 +34,9 @@ BodyPose ArmDirectionProposal(BodyPose pose, const ProposalContext& context, std
   const BodyShape& shape = context.shape;
   const PosedBody body = PoseBody(shape, pose);
   std::normal_distribution<double> jitter(0.0, 0.05);
-  const auto by_side = ArmPointsBySide(context.arm_chains.points, context.arm_chains.chain, context.arm_chains.count,
-                                       body.frames[kRightUpperArm].translation(),
-                                       body.frames[kLeftUpperArm].translation());
+  const auto by_side = ArmPointsBySide(
+      context.arm_chains.points, context.arm_chains.chain, context.arm_chains.count,
+      body.frames[kRightUpperArm].translation(), body.frames[kLeftUpperArm].translation());
   // Half the proposals set both arms, the rest one arm (either side alike):
   // the other arm keeps its pose, so that a raised arm the axis points miss
   // this frame is not forced down while the seen one is placed.
@@ -72,12 +74,15 @@ BodyPose ArmDirectionProposal(BodyPose pose, const ProposalContext& context, std
     }
     const Vector3d noise_u(jitter(rng), jitter(rng), jitter(rng));
     const Vector3d noise_f(jitter(rng), jitter(rng), jitter(rng));
-    SetArmDirections(shape, &pose, arm, (upper + noise_u).normalized(), (fore + noise_f).normalized());
+    SetArmDirections(shape, &pose, arm, (upper + noise_u).normalized(),
+                     (fore + noise_f).normalized());
   }
   return pose;
 }
 
-BodyPose DefaultPoseProposal(const BodyPose& current, const ProposalContext& context, std::mt19937_64& rng) {
+BodyPose DefaultPoseProposal(const BodyPose& current,
+                             const ProposalContext& context,
+                             std::mt19937_64& rng) {
   const BodyShape& shape = context.shape;
   std::uniform_int_distribution<int> which(0, 3);
   const Vector2d root = context.features.placement->root.head<2>();
@@ -151,8 +156,11 @@ void CapRise(const BodyShape& shape, double max_rise_m, BodyPose* pose) {
   pose->dof[kDofZ] = std::min(pose->dof[kDofZ], shape.waist_height_m + max_rise_m);
 }
 
-BodyPose RandomWalkProposal(const BodyPose& current, const BodyPose& previous, double k,
-                            const PoseTrackerOptions& options, std::normal_distribution<double>& n01,
+BodyPose RandomWalkProposal(const BodyPose& current,
+                            const BodyPose& previous,
+                            double k,
+                            const PoseTrackerOptions& options,
+                            std::normal_distribution<double>& n01,
                             std::mt19937_64& rng) {
   BodyPose next = current;
   // Random walk with velocity (thesis 6.3.2), capped.
@@ -171,27 +179,31 @@ BodyPose RandomWalkProposal(const BodyPose& current, const BodyPose& previous, d
   for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith}) {
     next.dof[d] += k * options.sigma_torso_rad * n01(rng);
   }
-  for (int d : {kDofRightShoulderAzimuth, kDofRightShoulderZenith, kDofLeftShoulderAzimuth, kDofLeftShoulderZenith,
-                kDofRightElbowAzimuth, kDofRightElbowZenith, kDofLeftElbowAzimuth, kDofLeftElbowZenith}) {
+  for (int d : {kDofRightShoulderAzimuth, kDofRightShoulderZenith, kDofLeftShoulderAzimuth,
+                kDofLeftShoulderZenith, kDofRightElbowAzimuth, kDofRightElbowZenith,
+                kDofLeftElbowAzimuth, kDofLeftElbowZenith}) {
     next.dof[d] += k * options.sigma_arm_rad * n01(rng);
   }
   next.dof[kDofRightShoulderTwist] = next.dof[kDofLeftShoulderTwist] = 0.0;
   return next;
 }
 
-BodyPose BodyPositionProposal(const BodyPose& current, const ProposalContext& context,
-                              std::normal_distribution<double>& n01, std::mt19937_64& rng) {
+BodyPose BodyPositionProposal(const BodyPose& current,
+                              const ProposalContext& context,
+                              std::normal_distribution<double>& n01,
+                              std::mt19937_64& rng) {
   BodyPose next = current;
   // Body position (thesis 6.3.2): the x and y of a random 3D torso axis
   // point (the trunk's middle, the waist spine_depth_m behind it), else
   // the voxel hull's root; while the user walks, the heading from the
   // hull's motion (people face where they walk).
-  if (context.walking) next.dof[kDofYaw] = YawFacing(context.velocity_xy.normalized()) + 0.1 * n01(rng);
+  if (context.walking)
+    next.dof[kDofYaw] = YawFacing(context.velocity_xy.normalized()) + 0.1 * n01(rng);
   const Vector2d noise(0.02 * n01(rng), 0.02 * n01(rng));
   if (!context.torso_xy.empty()) {
     std::uniform_int_distribution<size_t> pick(0, context.torso_xy.size() - 1);
-    const Vector2d xy =
-        context.torso_xy[pick(rng)] + noise - context.shape.spine_depth_m * FacingDirection(next.dof[kDofYaw]);
+    const Vector2d xy = context.torso_xy[pick(rng)] + noise -
+                        context.shape.spine_depth_m * FacingDirection(next.dof[kDofYaw]);
     next.dof[kDofX] = xy.x();
     next.dof[kDofY] = xy.y();
   } else {
@@ -200,8 +212,11 @@ BodyPose BodyPositionProposal(const BodyPose& current, const ProposalContext& co
   return next;
 }
 
-BodyPose ProposeParticle(const BodyPose& current, const BodyPose& previous, double dt,
-                         const ProposalContext& context, std::mt19937_64& rng) {
+BodyPose ProposeParticle(const BodyPose& current,
+                         const BodyPose& previous,
+                         double dt,
+                         const ProposalContext& context,
+                         std::mt19937_64& rng) {
   const PoseTrackerOptions& options = context.options;
   const double total = options.p_random_walk + options.p_body_position + options.p_arm_direction +
                        options.p_default_pose;
@@ -244,7 +259,8 @@ BodyPose ProposeParticle(const BodyPose& current, const BodyPose& previous, doub
   // An entering user (first seen half in view) likewise faces the stage's
   // centre until the walk itself is seen.
   if (context.walking || context.entering) {
-    const double heading = YawFacing(context.walking ? context.velocity_xy.normalized() : context.walk_dir);
+    const double heading =
+        YawFacing(context.walking ? context.velocity_xy.normalized() : context.walk_dir);
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
@@ -263,8 +279,12 @@ std::vector<double> WeighParticles(const std::vector<BodyPose>& particles, const
   return log_likelihood;
 }
 
-void RefineParticles(const BodyShape& shape, const std::vector<IcpView>& icp_views, const PoseTrackerOptions& options,
-                     const PoseScore& score, std::mt19937_64& rng, std::vector<BodyPose>* particles,
+void RefineParticles(const BodyShape& shape,
+                     const std::vector<IcpView>& icp_views,
+                     const PoseTrackerOptions& options,
+                     const PoseScore& score,
+                     std::mt19937_64& rng,
+                     std::vector<BodyPose>* particles,
                      std::vector<double>* log_likelihood) {
   std::vector<BodyPose>& proposed = *particles;
   const int n = static_cast<int>(proposed.size());
@@ -293,11 +313,15 @@ void RefineParticles(const BodyShape& shape, const std::vector<IcpView>& icp_vie
 }
 
 int BestParticle(const std::vector<double>& log_likelihood) {
-  return static_cast<int>(std::max_element(log_likelihood.begin(), log_likelihood.end()) - log_likelihood.begin());
+  return static_cast<int>(std::max_element(log_likelihood.begin(), log_likelihood.end()) -
+                          log_likelihood.begin());
 }
 
-void ResampleSystematic(const std::vector<BodyPose>& proposed, const std::vector<double>& log_likelihood,
-                        double max_ll, std::mt19937_64& rng, std::vector<BodyPose>* particles,
+void ResampleSystematic(const std::vector<BodyPose>& proposed,
+                        const std::vector<double>& log_likelihood,
+                        double max_ll,
+                        std::mt19937_64& rng,
+                        std::vector<BodyPose>* particles,
                         std::vector<BodyPose>* previous) {
   // Resampling (systematic), carrying each particle's previous state along
   // for the velocity.

@@ -19,8 +19,8 @@
 #include <random>
 #include <vector>
 
-#include "tracker/frontend/frontend.h"
 #include "tracker/body_model/body_model.h"
+#include "tracker/frontend/frontend.h"
 #include "tracker/pose/arm_points.h"
 #include "tracker/pose/icp.h"
 #include "tracker/pose/pose_tracker_options.h"
@@ -34,13 +34,15 @@ struct ProposalContext {
   const BodyShape& shape;
   const FrameFeatures& features;  // features.placement must be set
   const ArmChains& arm_chains;    // this frame's 3D arm axis points
-  const std::vector<Eigen::Vector2d>& torso_xy;  // this frame's torso axis points (world x, y, metres)
+  const std::vector<Eigen::Vector2d>&
+      torso_xy;                 // this frame's torso axis points (world x, y, metres)
   Eigen::Vector2d facing_xy;    // the heading users mostly face (towards the screens), unit
   Eigen::Vector2d velocity_xy;  // the hull's ground velocity, m/s
-  Eigen::Vector2d walk_dir;     // the last walking direction (or the stage's centre while entering), unit
-  bool walking = false;         // the user walks: the heading is the walk's
-  bool entering = false;        // first seen half in view, not yet seen walking
-  bool lost = false;            // last frame's best particle explained the silhouettes poorly
+  Eigen::Vector2d
+      walk_dir;           // the last walking direction (or the stage's centre while entering), unit
+  bool walking = false;   // the user walks: the heading is the walk's
+  bool entering = false;  // first seen half in view, not yet seen walking
+  bool lost = false;      // last frame's best particle explained the silhouettes poorly
 };
 
 // A particle's log-likelihood: the observation (thesis 6.3.1) plus the
@@ -52,21 +54,29 @@ using PoseScore = std::function<double(const BodyPose&)>;
 // picked at random (PoseTrackerOptions' p_*), then turned to the walk's
 // heading while the user walks or enters, joint limits applied and the rise
 // capped (CapRise).
-BodyPose ProposeParticle(const BodyPose& current, const BodyPose& previous, double dt,
-                         const ProposalContext& context, std::mt19937_64& rng);
+BodyPose ProposeParticle(const BodyPose& current,
+                         const BodyPose& previous,
+                         double dt,
+                         const ProposalContext& context,
+                         std::mt19937_64& rng);
 
 // Thesis 6.3.2, random walk with velocity: `current` moved on by the damped,
 // capped change since `previous`, plus Gaussian noise scaled by `k`
 // (sqrt(dt * 30)); draws from `n01` (standard normal) with `rng`.
-BodyPose RandomWalkProposal(const BodyPose& current, const BodyPose& previous, double k,
-                            const PoseTrackerOptions& options, std::normal_distribution<double>& n01,
+BodyPose RandomWalkProposal(const BodyPose& current,
+                            const BodyPose& previous,
+                            double k,
+                            const PoseTrackerOptions& options,
+                            std::normal_distribution<double>& n01,
                             std::mt19937_64& rng);
 
 // Thesis 6.3.2, body position: `current` moved to a random 3D torso axis
 // point (the trunk's middle, the waist spine_depth_m behind it), else to the
 // voxel hull's root; while the user walks, turned to the walking direction.
-BodyPose BodyPositionProposal(const BodyPose& current, const ProposalContext& context,
-                              std::normal_distribution<double>& n01, std::mt19937_64& rng);
+BodyPose BodyPositionProposal(const BodyPose& current,
+                              const ProposalContext& context,
+                              std::normal_distribution<double>& n01,
+                              std::mt19937_64& rng);
 
 // Thesis 6.3.2, arm directions from the 3D arm axis points: both arms or one
 // (at random) pointed along the points the arm's shoulder owns; an arm they
@@ -75,7 +85,9 @@ BodyPose ArmDirectionProposal(BodyPose pose, const ProposalContext& context, std
 
 // Thesis 6.3.2, default poses at the hull's root with `current`'s heading:
 // standing, scarecrow, or pointing forward with one arm.
-BodyPose DefaultPoseProposal(const BodyPose& current, const ProposalContext& context, std::mt19937_64& rng);
+BodyPose DefaultPoseProposal(const BodyPose& current,
+                             const ProposalContext& context,
+                             std::mt19937_64& rng);
 
 // `current` turned to heading `yaw` (radians) about the trunk's axis, its
 // arms kept pointing where they point in the world (PoseTrackerOptions::p_turn).
@@ -99,8 +111,12 @@ std::vector<double> WeighParticles(const std::vector<BodyPose>& particles, const
 // round(options.refine_fraction * n) particles; a refined particle (its rise
 // capped) replaces its original, and its score the original's, when it
 // scores higher. Nothing without ICP iterations.
-void RefineParticles(const BodyShape& shape, const std::vector<IcpView>& icp_views, const PoseTrackerOptions& options,
-                     const PoseScore& score, std::mt19937_64& rng, std::vector<BodyPose>* particles,
+void RefineParticles(const BodyShape& shape,
+                     const std::vector<IcpView>& icp_views,
+                     const PoseTrackerOptions& options,
+                     const PoseScore& score,
+                     std::mt19937_64& rng,
+                     std::vector<BodyPose>* particles,
                      std::vector<double>* log_likelihood);
 
 // The index of the highest log-likelihood (the first of equals).
@@ -110,8 +126,11 @@ int BestParticle(const std::vector<double>& log_likelihood);
 // exp(log_likelihood - max_ll). `particles` holds the particles the
 // proposals started from and receives the resampled ones; `previous`
 // receives each one's state before it (for the random walk's velocity).
-void ResampleSystematic(const std::vector<BodyPose>& proposed, const std::vector<double>& log_likelihood,
-                        double max_ll, std::mt19937_64& rng, std::vector<BodyPose>* particles,
+void ResampleSystematic(const std::vector<BodyPose>& proposed,
+                        const std::vector<double>& log_likelihood,
+                        double max_ll,
+                        std::mt19937_64& rng,
+                        std::vector<BodyPose>* particles,
                         std::vector<BodyPose>* previous);
 
 }  // namespace irbench

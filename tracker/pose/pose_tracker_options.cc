@@ -14,11 +14,13 @@ void PoseTrackerOptions::Check() const {
     if (!(p >= 0)) throw InputError("", "pose.proposal_probabilities", "must be non-negative");
   }
   if (!(p_flip >= 0 && p_flip <= 1)) throw InputError("", "pose.p_flip", "must be in [0, 1]");
-  if (!(p_turn >= 0 && p_flip + p_turn <= 1)) throw InputError("", "pose.p_turn", "must be in [0, 1 - p_flip]");
+  if (!(p_turn >= 0 && p_flip + p_turn <= 1))
+    throw InputError("", "pose.p_turn", "must be in [0, 1 - p_flip]");
   if (!(p_random_walk + p_body_position + p_arm_direction + p_default_pose > 0)) {
     throw InputError("", "pose.proposal_probabilities", "must not all be zero");
   }
-  for (double s : {sigma_position_m, sigma_yaw_rad, sigma_torso_rad, sigma_arm_rad, max_step_rad, max_step_m}) {
+  for (double s : {sigma_position_m, sigma_yaw_rad, sigma_torso_rad, sigma_arm_rad, max_step_rad,
+                   max_step_m}) {
     if (!(s >= 0)) throw InputError("", "pose.noise_and_caps", "must be non-negative");
   }
   if (!(velocity_damping >= 0 && velocity_damping <= 1)) {
@@ -27,8 +29,10 @@ void PoseTrackerOptions::Check() const {
   if (!(refine_fraction >= 0 && refine_fraction <= 1)) {
     throw InputError("", "pose.refine_fraction", "must be in [0, 1]");
   }
-  if (!(min_overlap >= 0 && min_overlap <= 1)) throw InputError("", "pose.min_overlap", "must be in [0, 1]");
-  if (!(rest_max_log_overlap_loss >= 0)) throw InputError("", "pose.rest_max_log_overlap_loss", "must be non-negative");
+  if (!(min_overlap >= 0 && min_overlap <= 1))
+    throw InputError("", "pose.min_overlap", "must be in [0, 1]");
+  if (!(rest_max_log_overlap_loss >= 0))
+    throw InputError("", "pose.rest_max_log_overlap_loss", "must be non-negative");
   if (!(max_rise_m >= 0)) throw InputError("", "pose.max_rise_m", "must be non-negative");
   if (!(rest_seen_max_angle_deg >= 0 && rest_seen_max_angle_deg <= 180)) {
     throw InputError("", "pose.rest_seen_max_angle_deg", "must be in [0, 180]");
@@ -36,16 +40,22 @@ void PoseTrackerOptions::Check() const {
   if (!(rest_lifted_angle_deg >= 0 && rest_lifted_angle_deg <= 180)) {
     throw InputError("", "pose.rest_lifted_angle_deg", "must be in [0, 180]");
   }
-  if (!(rest_lifted_memory_s >= 0)) throw InputError("", "pose.rest_lifted_memory_s", "must be non-negative");
+  if (!(rest_lifted_memory_s >= 0))
+    throw InputError("", "pose.rest_lifted_memory_s", "must be non-negative");
   if (rest_lifted_angle_deg < rest_seen_max_angle_deg) {
-    throw InputError("", "pose.rest_lifted_angle_deg", "must be at least pose.rest_seen_max_angle_deg");
+    throw InputError("", "pose.rest_lifted_angle_deg",
+                     "must be at least pose.rest_seen_max_angle_deg");
   }
   hull_head.Check();
   if (height_frames < 1) throw InputError("", "pose.height_frames", "must be at least 1");
-  if (arm_thickness_frames < 0) throw InputError("", "pose.arm_thickness_frames", "must be non-negative");
-  if (arm_thickness_min_points < 1) throw InputError("", "pose.arm_thickness_min_points", "must be at least 1");
-  if (!(arm_reference_diameter > 0)) throw InputError("", "pose.arm_reference_diameter", "must be positive");
-  if (!(max_arm_thickness >= 1)) throw InputError("", "pose.max_arm_thickness", "must be at least 1");
+  if (arm_thickness_frames < 0)
+    throw InputError("", "pose.arm_thickness_frames", "must be non-negative");
+  if (arm_thickness_min_points < 1)
+    throw InputError("", "pose.arm_thickness_min_points", "must be at least 1");
+  if (!(arm_reference_diameter > 0))
+    throw InputError("", "pose.arm_reference_diameter", "must be positive");
+  if (!(max_arm_thickness >= 1))
+    throw InputError("", "pose.max_arm_thickness", "must be at least 1");
   if (!(walk_memory_s >= 0)) throw InputError("", "pose.walk_memory_s", "must be non-negative");
 }
 
