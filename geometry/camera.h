@@ -20,9 +20,6 @@ struct Camera {
   std::array<double, 5> dist{};           // k1 k2 p1 p2 k3
   // OpenCV camera frame: x right, y down, z forward (the optical axis).
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
-  // Timing of the sensor (the sequence's calibration carries it).
-  double fps = 30.0;
-  double exposure_ms = 10.0;
 
   Eigen::Matrix3d K() const;
   Eigen::Vector3d CenterInWorld() const { return cam_from_world.inverse().translation(); }

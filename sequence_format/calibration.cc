@@ -113,16 +113,16 @@ void ReadExtrinsics(const cv::FileStorage& extri, const std::string& file, Camer
 }
 
 // Image size, fps and exposure of camera `cam.name` from cameras.json's list.
-void ReadTiming(const JsonNode& list, const std::string& file, Camera& cam) {
+void ReadTiming(const JsonNode& list, const std::string& file, Camera& cam, CameraTiming& timing) {
   bool found = false;
   for (size_t i = 0; i < list.Size(); ++i) {
     if (list[i].GetString("name") != cam.name) continue;
     cam.width = list[i].GetInt("width");
     cam.height = list[i].GetInt("height");
     if (cam.width <= 0 || cam.height <= 0) list[i]["width"].Fail("image size must be positive");
-    cam.fps = list[i].GetDouble("fps");
-    if (!(cam.fps > 0 && std::isfinite(cam.fps))) list[i]["fps"].Fail("must be > 0");
-    cam.exposure_ms = list[i].GetDouble("exposure_ms", cam.exposure_ms);
+    timing.fps = list[i].GetDouble("fps");
+    if (!(timing.fps > 0 && std::isfinite(timing.fps))) list[i]["fps"].Fail("must be > 0");
+    timing.exposure_ms = list[i].GetDouble("exposure_ms", timing.exposure_ms);
     found = true;
   }
   if (!found) throw InputError(file, "cameras", "no camera named '" + cam.name + "'");
@@ -157,6 +157,7 @@ std::string ExtriYaml(const std::vector<Camera>& cameras) {
 }
 
 nlohmann::json CamerasJson(const std::vector<Camera>& cameras,
+                           const std::vector<CameraTiming>& timing,
                            const std::vector<nlohmann::json>& sensors) {
   nlohmann::json j;
   j["format"] = kCamerasFormat;
@@ -179,8 +180,8 @@ nlohmann::json CamerasJson(const std::vector<Camera>& cameras,
     c["T"] = {t.x(), t.y(), t.z()};
     const Eigen::Vector3d center = cam.CenterInWorld();
     c["center_in_world"] = {center.x(), center.y(), center.z()};
-    c["fps"] = cam.fps;
-    c["exposure_ms"] = cam.exposure_ms;
+    c["fps"] = timing.at(i).fps;
+    c["exposure_ms"] = timing.at(i).exposure_ms;
     c["sensor"] = sensors.at(i);
     j["cameras"].push_back(c);
   }
@@ -189,13 +190,14 @@ nlohmann::json CamerasJson(const std::vector<Camera>& cameras,
 
 void WriteCalibration(const fs::path& sequence_dir,
                       const std::vector<Camera>& cameras,
+                      const std::vector<CameraTiming>& timing,
                       const std::vector<nlohmann::json>& sensors) {
   AtomicWriteFile(sequence_dir / kIntriFile, IntriYaml(cameras));
   AtomicWriteFile(sequence_dir / kExtriFile, ExtriYaml(cameras));
-  AtomicWriteFile(sequence_dir / kCamerasFile, CamerasJson(cameras, sensors).dump(2) + "\n");
+  AtomicWriteFile(sequence_dir / kCamerasFile, CamerasJson(cameras, timing, sensors).dump(2) + "\n");
 }
 
-std::vector<Camera> ReadCalibration(const fs::path& dir) {
+Calibration ReadCalibration(const fs::path& dir) {
   const fs::path intri_file = dir / kIntriFile, extri_file = dir / kExtriFile;
   const fs::path cameras_file = dir / kCamerasFile;
   for (const fs::path& f : {intri_file, extri_file, cameras_file}) {
@@ -213,16 +215,18 @@ std::vector<Camera> ReadCalibration(const fs::path& dir) {
   if (names.empty()) throw InputError(intri_file.string(), kNamesKey, "missing or empty");
   const JsonNode cameras_json = ParseJsonFile(cameras_file.string());
   const JsonNode list = cameras_json["cameras"];
-  std::vector<Camera> cameras;
+  Calibration calibration;
   for (const std::string& name : names) {
     Camera cam;
     cam.name = name;
+    CameraTiming timing;
     ReadIntrinsics(intri, intri_file.string(), cam);
     ReadExtrinsics(extri, extri_file.string(), cam);
-    ReadTiming(list, cameras_file.string(), cam);
-    cameras.push_back(cam);
+    ReadTiming(list, cameras_file.string(), cam, timing);
+    calibration.cameras.push_back(cam);
+    calibration.timing.push_back(timing);
   }
-  return cameras;
+  return calibration;
 }
 
 }  // namespace irbench

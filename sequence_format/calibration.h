@@ -20,6 +20,19 @@ inline constexpr char kExtriFile[] = "calib/extri.yml";
 inline constexpr char kCamerasFile[] = "calib/cameras.json";
 inline constexpr char kCamerasFormat[] = "irbench.cameras/1";
 
+// A camera's timing, beside its geometry (Camera): the frame rate and the
+// exposure (a sequence's cameras share one clock: the render job checks it).
+struct CameraTiming {
+  double fps = 30.0;
+  double exposure_ms = 10.0;
+};
+
+// What a sequence's calibration gives, per camera in `names` order.
+struct Calibration {
+  std::vector<Camera> cameras;
+  std::vector<CameraTiming> timing;
+};
+
 // intri.yml: names, K_<cam> (3x3), dist_<cam> (1x5).
 std::string IntriYaml(const std::vector<Camera>& cameras);
 // extri.yml: names, R_<cam> (3x1 Rodrigues), Rot_<cam> (3x3), T_<cam> (3x1 m);
@@ -29,11 +42,13 @@ std::string ExtriYaml(const std::vector<Camera>& cameras);
 // sensor model's parameters as the sim describes them (`sensors`, one object
 // per camera; the reader ignores them).
 nlohmann::json CamerasJson(const std::vector<Camera>& cameras,
+                           const std::vector<CameraTiming>& timing,
                            const std::vector<nlohmann::json>& sensors);
 
 // Writes the three files under `sequence_dir` (each atomically).
 void WriteCalibration(const std::filesystem::path& sequence_dir,
                       const std::vector<Camera>& cameras,
+                      const std::vector<CameraTiming>& timing,
                       const std::vector<nlohmann::json>& sensors);
 
 // Reads the cameras of a sequence folder, in intri.yml's `names` order:
@@ -41,6 +56,6 @@ void WriteCalibration(const std::filesystem::path& sequence_dir,
 // (Rot_ and T_), image size, fps and exposure from cameras.json. Throws
 // InputError naming the file and key when one is missing or malformed (a
 // rotation that is not one, a focal length <= 0, a NaN, ...).
-std::vector<Camera> ReadCalibration(const std::filesystem::path& sequence_dir);
+Calibration ReadCalibration(const std::filesystem::path& sequence_dir);
 
 }  // namespace irbench

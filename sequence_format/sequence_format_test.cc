@@ -30,8 +30,6 @@ class SequenceFormatTest : public ::testing::Test {
     cameras[0].fx = 260.5, cameras[0].fy = 261.25, cameras[0].cx = 160.1, cameras[0].cy = 119.7;
     cameras[0].dist = {-0.2, 0.04, 0.001, -0.002, 0.003};
     cameras[0].cam_from_world = *LookAt({0.3, -3.1, 2.2}, {0, 0, 1}, Eigen::Vector3d::UnitZ());
-    cameras[0].fps = 25;
-    cameras[0].exposure_ms = 8;
     cameras[1].name = "overhead";
     cameras[1].width = 640, cameras[1].height = 480;
     cameras[1].fx = cameras[1].fy = 400, cameras[1].cx = 319.5, cameras[1].cy = 239.5;
@@ -53,9 +51,12 @@ class SequenceFormatTest : public ::testing::Test {
 // FileStorage finds the EasyMocap keys with a Rodrigues vector that matches Rot_.
 TEST_F(SequenceFormatTest, CalibrationRoundTripsAndOpenCvReadsIt) {
   const std::vector<Camera> cameras = Cameras();
-  WriteCalibration(dir_, cameras,
+  const std::vector<CameraTiming> timing = {{25, 8}, {30, 10}};
+  WriteCalibration(dir_, cameras, timing,
                    {nlohmann::json{{"preset", "clean"}}, nlohmann::json{{"preset", "thesis"}}});
-  const std::vector<Camera> read = ReadCalibration(dir_);
+  const Calibration calibration = ReadCalibration(dir_);
+  const std::vector<Camera>& read = calibration.cameras;
+  ASSERT_EQ(calibration.timing.size(), 2u);
   ASSERT_EQ(read.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(read[i].name, cameras[i].name);
@@ -64,8 +65,8 @@ TEST_F(SequenceFormatTest, CalibrationRoundTripsAndOpenCvReadsIt) {
     EXPECT_DOUBLE_EQ(read[i].fx, cameras[i].fx);
     EXPECT_DOUBLE_EQ(read[i].cy, cameras[i].cy);
     EXPECT_EQ(read[i].dist, cameras[i].dist);
-    EXPECT_DOUBLE_EQ(read[i].fps, cameras[i].fps);
-    EXPECT_DOUBLE_EQ(read[i].exposure_ms, cameras[i].exposure_ms);
+    EXPECT_DOUBLE_EQ(calibration.timing[i].fps, timing[i].fps);
+    EXPECT_DOUBLE_EQ(calibration.timing[i].exposure_ms, timing[i].exposure_ms);
     EXPECT_LT((read[i].cam_from_world.matrix() - cameras[i].cam_from_world.matrix())
                   .cwiseAbs()
                   .maxCoeff(),
@@ -81,14 +82,14 @@ TEST_F(SequenceFormatTest, CalibrationRoundTripsAndOpenCvReadsIt) {
 
 TEST_F(SequenceFormatTest, CalibrationErrorsNameTheKey) {
   std::vector<Camera> cameras = Cameras();
-  WriteCalibration(dir_, cameras, {nlohmann::json::object(), nlohmann::json::object()});
+  WriteCalibration(dir_, cameras, {{}, {}}, {nlohmann::json::object(), nlohmann::json::object()});
   // A camera in the YAML files but not in cameras.json.
   std::ofstream(dir_ / "calib/cameras.json") << R"({"format": "irbench.cameras/1", "cameras": [
       {"name": "front", "width": 320, "height": 240, "fps": 25}]})";
   EXPECT_EQ(ReadErrorField(), "cameras");
   // A focal length of zero.
   cameras[1].fx = 0;
-  WriteCalibration(dir_, cameras, {nlohmann::json::object(), nlohmann::json::object()});
+  WriteCalibration(dir_, cameras, {{}, {}}, {nlohmann::json::object(), nlohmann::json::object()});
   EXPECT_EQ(ReadErrorField(), "K_overhead");
   fs::remove(dir_ / "calib/extri.yml");
   try {

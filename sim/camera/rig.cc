@@ -76,13 +76,15 @@ Rig LoadRig(const std::filesystem::path& path) {
     const auto cam_from_world = LookAt(position, look_at, up);
     if (!cam_from_world) c["look_at"].Fail("view direction is zero or parallel to 'up'");
     cam.cam_from_world = *cam_from_world;
-    cam.fps = c.GetDouble("fps", 30.0);
-    if (cam.fps <= 0 || cam.fps > 1000) c["fps"].Fail("must be in (0, 1000]");
-    cam.exposure_ms = c.GetDouble("exposure_ms", 10.0);
-    if (cam.exposure_ms <= 0 || cam.exposure_ms > 1000.0 / cam.fps + 1e-9) {
+    CameraTiming timing;
+    timing.fps = c.GetDouble("fps", 30.0);
+    if (timing.fps <= 0 || timing.fps > 1000) c["fps"].Fail("must be in (0, 1000]");
+    timing.exposure_ms = c.GetDouble("exposure_ms", 10.0);
+    if (timing.exposure_ms <= 0 || timing.exposure_ms > 1000.0 / timing.fps + 1e-9) {
       c["exposure_ms"].Fail("must be positive and at most the frame period");
     }
     rig.cameras.push_back(cam);
+    rig.timing.push_back(timing);
     rig.sensor_overrides.push_back(c.Has("sensor") ? c["sensor"].raw() : nlohmann::json());
   }
   return rig;

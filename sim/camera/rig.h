@@ -1,6 +1,7 @@
 #pragma once
 // Camera rigs (rigs/*.json): per camera resolution, intrinsics, distortion, a
-// pose as position + look-at + up, fps and exposure. Format in docs/formats.md.
+// pose as position + look-at + up (a Camera), fps and exposure (its
+// CameraTiming). Format in docs/formats.md.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "geometry/camera.h"
+#include "sequence_format/calibration.h"
 
 namespace irbench {
 
@@ -15,6 +17,7 @@ struct Rig {
   std::string name;
   std::string scene;  // the scene the rig was designed for (default for --scene)
   std::vector<Camera> cameras;
+  std::vector<CameraTiming> timing;  // per camera: fps, exposure
   // Per camera, the "sensor" object of the rig file (knob overrides of the
   // sensor preset: {"sensor": {...}, "flicker": {...}}), or null.
   std::vector<nlohmann::json> sensor_overrides;

@@ -3,13 +3,14 @@
 namespace irbench {
 
 RigExposure::CameraChain::CameraChain(const Camera& camera,
+                                      double camera_exposure_ms,
                                       const SensorSetup& camera_setup,
                                       bool is_active,
                                       uint64_t seed,
                                       double start_s,
                                       double end_s)
     : name(camera.name),
-      exposure_ms(camera.exposure_ms),
+      exposure_ms(camera_exposure_ms),
       setup(camera_setup),
       active(is_active),
       sensor(camera_setup.sensor, seed, camera.name, camera.width, camera.height),
@@ -17,6 +18,7 @@ RigExposure::CameraChain::CameraChain(const Camera& camera,
       optics(camera_setup.optics, camera) {}
 
 RigExposure::RigExposure(const std::vector<Camera>& cameras,
+                         const std::vector<CameraTiming>& timing,
                          const std::vector<SensorSetup>& setups,
                          const std::vector<bool>& active,
                          uint64_t seed,
@@ -25,7 +27,7 @@ RigExposure::RigExposure(const std::vector<Camera>& cameras,
     : seed_(seed) {
   chains_.reserve(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
-    chains_.emplace_back(cameras[c], setups[c], active[c], seed, start_s, end_s);
+    chains_.emplace_back(cameras[c], timing[c].exposure_ms, setups[c], active[c], seed, start_s, end_s);
   }
 }
 

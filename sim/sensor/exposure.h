@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "geometry/camera.h"
+#include "sequence_format/calibration.h"
 #include "sim/sensor/flicker.h"
 #include "sim/sensor/optics.h"
 #include "sim/sensor/sensor_model.h"
@@ -35,6 +36,7 @@ class RigExposure {
   // render as is. The flicker's seeded events span [start_s, end_s] (s).
   // Builds each camera's sensor model, flicker model and optics in that order.
   RigExposure(const std::vector<Camera>& cameras,
+              const std::vector<CameraTiming>& timing,
               const std::vector<SensorSetup>& setups,
               const std::vector<bool>& active,
               uint64_t seed,
@@ -66,6 +68,7 @@ class RigExposure {
   // One camera's chain and the state a dropped frame repeats.
   struct CameraChain {
     CameraChain(const Camera& camera,
+                double exposure_ms,
                 const SensorSetup& camera_setup,
                 bool is_active,
                 uint64_t seed,

@@ -87,9 +87,9 @@ RenderInputs LoadRenderInputs(const RenderJobOptions& options) {
   in.motion_kind = resolved.kind;
   in.motion_file = resolved.file;
   in.motion_name = in.motion->name();
-  in.fps = in.rig.cameras.front().fps;
-  for (size_t i = 1; i < in.rig.cameras.size(); ++i) {
-    if (in.rig.cameras[i].fps != in.fps) {
+  in.fps = in.rig.timing.front().fps;
+  for (size_t i = 1; i < in.rig.timing.size(); ++i) {
+    if (in.rig.timing[i].fps != in.fps) {
       throw InputError(in.rig_file.string(), "cameras[" + std::to_string(i) + "].fps",
                        "differs from cameras[0].fps; per-camera clocks are not supported yet");
     }
@@ -190,7 +190,7 @@ void CreateSequenceFolders(const fs::path& root, const RenderInputs& in, bool wr
 void WriteSequenceCalibration(const fs::path& root, const RenderInputs& in) {
   std::vector<nlohmann::json> sensors;
   for (const SensorSetup& sensor : in.sensors) sensors.push_back(SensorSetupJson(sensor));
-  WriteCalibration(root, in.rig.cameras, sensors);
+  WriteCalibration(root, in.rig.cameras, in.rig.timing, sensors);
   WriteScreens(root, in.scene.name, in.scene.screens);
 }
 
@@ -298,12 +298,12 @@ struct MotionBlurPlan {
 MotionBlurPlan PlanMotionBlur(const RenderInputs& in) {
   MotionBlurPlan blur;
   for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
-    const Camera& cam = in.rig.cameras[c];
+    const CameraTiming& timing = in.rig.timing[c];
     const SensorSetup& setup = in.sensors[c];
     if (!in.sensor_active[c]) continue;
     if (setup.optics.motion_blur_samples > blur.samples) blur.samples = setup.optics.motion_blur_samples;
     if (setup.optics.motion_blur_samples > 1) {
-      blur.exposure_s = std::max(blur.exposure_s, cam.exposure_ms / 1000.0);
+      blur.exposure_s = std::max(blur.exposure_s, timing.exposure_ms / 1000.0);
     }
   }
   for (int k = 0; blur.samples > 1 && k < blur.samples; ++k) {
@@ -564,7 +564,7 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   const int total = options.background_frames + in.frame_count;
   // The sensor model per camera; background frames come before t = 0.
   const double background_s = options.background_frames / in.fps;
-  RigExposure exposure(in.rig.cameras, in.sensors, in.sensor_active, options.seed, -background_s,
+  RigExposure exposure(in.rig.cameras, in.rig.timing, in.sensors, in.sensor_active, options.seed, -background_s,
                        in.frame_count / in.fps);
   const MotionBlurPlan blur = PlanMotionBlur(in);
   RenderRun run{options, in, renderer, root, exposure, progress, NeedsDepth(options, in), {}};

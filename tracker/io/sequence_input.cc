@@ -44,7 +44,9 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
   SequenceInput in;
   in.dir_ = dir;
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "", "no such sequence folder");
-  in.cameras_ = ReadCalibration(dir);
+  Calibration calibration = ReadCalibration(dir);
+  in.cameras_ = std::move(calibration.cameras);
+  in.timing_ = std::move(calibration.timing);
   in.screens_ = ReadScreens(dir);
   for (size_t c = 0; c < in.cameras_.size(); ++c) {
     const int frames = CountNumbered(dir / "frames" / in.cameras_[c].name);

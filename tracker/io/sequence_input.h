@@ -13,6 +13,7 @@
 
 #include "geometry/camera.h"
 #include "geometry/screen.h"
+#include "sequence_format/calibration.h"
 
 namespace irbench {
 
@@ -26,7 +27,9 @@ class SequenceInput {
   const std::vector<Camera>& cameras() const { return cameras_; }
   int frame_count() const { return frame_count_; }
   int background_count() const { return background_count_; }
-  double fps() const { return cameras_.empty() ? 30.0 : cameras_.front().fps; }
+  double fps() const { return timing_.empty() ? 30.0 : timing_.front().fps; }
+  // Per camera: fps and exposure (calib/cameras.json).
+  const std::vector<CameraTiming>& timing() const { return timing_; }
   // The projection screens as surveyed (calib/screens.json; empty when the
   // file is absent): geometry and named targets.
   const std::vector<ScreenSurface>& screens() const { return screens_; }
@@ -47,6 +50,7 @@ class SequenceInput {
 
   std::filesystem::path dir_;
   std::vector<Camera> cameras_;
+  std::vector<CameraTiming> timing_;
   std::vector<ScreenSurface> screens_;
   int frame_count_ = 0;
   int background_count_ = 0;
