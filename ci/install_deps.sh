@@ -15,6 +15,7 @@ PACKAGES=(
   libassimp-dev libtinygltf-dev
   gnuplot-nox   # the report's plots (irbench score)
   chromium      # the report's test opens it in headless Chromium
+  python3       # ci/checks/code_shape.py (a CTest test): function and file sizes, layering
 )
 
 missing=()
