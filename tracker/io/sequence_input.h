@@ -28,8 +28,6 @@ class SequenceInput {
   int frame_count() const { return frame_count_; }
   int background_count() const { return background_count_; }
   double fps() const { return timing_.empty() ? 30.0 : timing_.front().fps; }
-  // Per camera: fps and exposure (calib/cameras.json).
-  const std::vector<CameraTiming>& timing() const { return timing_; }
   // The projection screens as surveyed (calib/screens.json; empty when the
   // file is absent): geometry and named targets.
   const std::vector<ScreenSurface>& screens() const { return screens_; }

@@ -316,7 +316,6 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   const TrackerSettings& settings = options.tracker;
   CheckTrackerSettings(settings);
   const FrontEndOptions fe_options = JobFrontEndOptions(options);
-  fe_options.Check();
   CheckOutputOutsideSequence(options);
   const SequenceInput input = SequenceInput::Open(options.sequence);
   const std::shared_ptr<const RestClassifier> rest_classifier = LoadRestClassifier(settings);

@@ -228,7 +228,7 @@ void CheckTrackerSettings(const TrackerSettings& settings) {
       throw InputError("", s.flag, "'" + ValueText(SettingValue(s, settings)) + "': " + problem);
     }
   }
-  settings.frontend.Check();
+  EffectiveFrontEndOptions(settings).Check();  // the options the front end runs with
   settings.pose.Check();
 }
 
