@@ -130,6 +130,21 @@ void ReadTiming(const JsonNode& list, const std::string& file, Camera& cam, Came
 
 }  // namespace
 
+std::string CameraNameProblem(const std::string& name) {
+  if (name.empty()) return "a camera name must not be empty";
+  if (name.size() > kMaxCameraNameLength) {
+    return "a camera name has at most " + std::to_string(kMaxCameraNameLength) +
+           " characters (got " + std::to_string(name.size()) + ")";
+  }
+  for (const char c : name) {
+    const bool safe = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                      c == '_' || c == '-';
+    if (!safe) return "a camera name may hold only A-Z, a-z, 0-9, '_' and '-'";
+  }
+  if (name[0] == '-') return "a camera name must not start with '-'";
+  return "";
+}
+
 std::string IntriYaml(const std::vector<Camera>& cameras) {
   cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
   WriteNames(fs, cameras);
@@ -213,6 +228,12 @@ Calibration ReadCalibration(const fs::path& dir) {
     throw InputError(intri_file.string(), kNamesKey, "expected a list of camera names: " + e.msg);
   }
   if (names.empty()) throw InputError(intri_file.string(), kNamesKey, "missing or empty");
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (const std::string problem = CameraNameProblem(names[i]); !problem.empty()) {
+      throw InputError(intri_file.string(), std::string(kNamesKey) + "[" + std::to_string(i) + "]",
+                       problem);
+    }
+  }
   const JsonNode cameras_json = ParseJsonFile(cameras_file.string());
   const JsonNode list = cameras_json["cameras"];
   Calibration calibration;

@@ -20,6 +20,14 @@ inline constexpr char kExtriFile[] = "calib/extri.yml";
 inline constexpr char kCamerasFile[] = "calib/cameras.json";
 inline constexpr char kCamerasFormat[] = "irbench.cameras/1";
 
+// Camera names become folder names, file names and FileStorage keys
+// (K_<name>), so they are restricted to a safe set: 1 to kMaxCameraNameLength
+// characters from [A-Za-z0-9_-], not starting with '-' (no dots, no spaces,
+// no slashes, ASCII only).
+inline constexpr size_t kMaxCameraNameLength = 64;
+// "" when `name` is a valid camera name, else what is wrong with it.
+std::string CameraNameProblem(const std::string& name);
+
 // A camera's timing, beside its geometry (Camera): the frame rate and the
 // exposure (a sequence's cameras share one clock: the render job checks it).
 struct CameraTiming {
@@ -55,7 +63,8 @@ void WriteCalibration(const std::filesystem::path& sequence_dir,
 // intrinsics and distortion from intri.yml, cam_from_world from extri.yml
 // (Rot_ and T_), image size, fps and exposure from cameras.json. Throws
 // InputError naming the file and key when one is missing or malformed (a
-// rotation that is not one, a focal length <= 0, a NaN, ...).
+// rotation that is not one, a focal length <= 0, a NaN, a camera name outside
+// the safe set of CameraNameProblem: field "names[i]" of intri.yml, ...).
 Calibration ReadCalibration(const std::filesystem::path& sequence_dir);
 
 }  // namespace irbench

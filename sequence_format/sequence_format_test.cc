@@ -100,6 +100,33 @@ TEST_F(SequenceFormatTest, CalibrationErrorsNameTheKey) {
   }
 }
 
+// Issue 27.3: the tracker reads camera names from calib/intri.yml; names
+// outside [A-Za-z0-9_-] (1-64 characters, not starting with '-') are refused
+// naming the file and the field.
+TEST_F(SequenceFormatTest, UnsafeCameraNamesAreRefused) {
+  WriteCalibration(dir_, Cameras(), {{}, {}}, {nlohmann::json::object(), nlohmann::json::object()});
+  std::ifstream in(dir_ / "calib/intri.yml");
+  const std::string intri((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = intri.find("- overhead");
+  ASSERT_NE(at, std::string::npos) << intri;
+  for (const std::string& bad :
+       {std::string("\"..\""), std::string("\".\""), std::string(300, 'a'), std::string("kamera_\u00fc"),
+        std::string("\"-x\""), std::string("\"a/b\"")}) {
+    std::string text = intri;
+    text.replace(at, std::string("- overhead").size(), "- " + bad);
+    std::ofstream(dir_ / "calib/intri.yml") << text;
+    try {
+      ReadCalibration(dir_);
+      ADD_FAILURE() << "no error for " << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "names[1]") << bad << ": " << e.what();
+      EXPECT_NE(e.file().find("intri.yml"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(CameraNameProblem("front_left-2"), "");
+  EXPECT_NE(CameraNameProblem(std::string(65, 'c')), "");
+}
+
 TEST_F(SequenceFormatTest, ScreensRoundTripWithTheirTargets) {
   ScreenSurface wall;
   wall.name = "wall";

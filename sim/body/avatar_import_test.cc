@@ -9,12 +9,14 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 
 #include "common/error.h"
 #include "sim/body/gltf_export.h"
+#include "sim/body/parametric.h"
 
 namespace irbench {
 namespace {
@@ -572,6 +574,76 @@ TEST(ImportErrors, MissingFile) {
   EXPECT_EQ(ErrorField([] { ImportRiggedAvatar("/nonexistent/irbench/avatar.glb"); }, &message),
             "file");
   EXPECT_NE(message.find("/nonexistent/irbench/avatar.glb"), std::string::npos) << message;
+}
+
+// A GLB of a parametric avatar (gltf_export.cc), read back for surgery.
+Glb ParametricGlb(const fs::path& dir) {
+  AvatarParams params;
+  params.name = "surgery";
+  WriteAvatarGlb(BuildParametricAvatar(params, BodyShape()), dir / "parametric.glb");
+  return ReadGlb(dir / "parametric.glb");
+}
+
+// Issue 27.3: a GLB whose accessor claims 10^9 elements made the importer
+// allocate ~22 GiB (and spend a minute) before its error. Every accessor's
+// and buffer view's size is now checked against the bytes there before
+// anything is allocated, and the error names the field.
+TEST(ImportErrors, OversizedAccessorsAreRefusedBeforeAllocating) {
+  const fs::path dir = TempDir();
+  const Glb good = ParametricGlb(dir);
+  EXPECT_NO_THROW(ImportRiggedAvatar(dir / "parametric.glb"));
+  const int position = good.json["meshes"][0]["primitives"][0]["attributes"]["POSITION"];
+  const int view = good.json["accessors"][position]["bufferView"];
+  auto field_of = [&](const std::string& name, const std::function<void(nlohmann::json&)>& patch) {
+    Glb glb = good;
+    patch(glb.json);
+    WriteGlb(dir / name, glb);
+    std::string message;
+    const std::string field = ErrorField([&] { ImportRiggedAvatar(dir / name); }, &message);
+    EXPECT_NE(message.find((dir / name).string()), std::string::npos) << message;
+    std::printf("%s: %s\n", name.c_str(), message.c_str());
+    return field;
+  };
+  const std::string accessor = "accessors[" + std::to_string(position) + "]";
+  EXPECT_EQ(field_of("count.glb",
+                     [&](nlohmann::json& j) { j["accessors"][position]["count"] = 1000000000; }),
+            accessor + ".count");
+  // Without a buffer view the accessor is zeros; it still cannot claim more
+  // elements than the input has bytes.
+  EXPECT_EQ(field_of("zeros.glb",
+                     [&](nlohmann::json& j) {
+                       j["accessors"][position]["count"] = 1000000000;
+                       j["accessors"][position].erase("bufferView");
+                       j["accessors"][position].erase("byteOffset");
+                     }),
+            accessor + ".count");
+  // A buffer view longer than its buffer.
+  EXPECT_EQ(field_of("view.glb",
+                     [&](nlohmann::json& j) { j["bufferViews"][view]["byteLength"] = 4000000000u; }),
+            "bufferViews[" + std::to_string(view) + "].byteLength");
+  fs::remove_all(dir);
+}
+
+// A chain of 100,000 nodes above the skinned mesh: its world transform is
+// composed without recursion (a recursive walk overflowed the stack).
+TEST(ImportErrors, DeepNodeChainIsNoStackOverflow) {
+  const fs::path dir = TempDir();
+  Glb glb = ParametricGlb(dir);
+  const int count = 100000;
+  const int first = static_cast<int>(glb.json["nodes"].size());
+  const int body = first - 1;  // the mesh node comes after the joints
+  ASSERT_TRUE(glb.json["nodes"][body].contains("skin"));
+  for (int k = 0; k < count; ++k) {
+    glb.json["nodes"].push_back({{"children", {k + 1 < count ? first + k + 1 : body}}});
+  }
+  for (auto& root : glb.json["scenes"][0]["nodes"]) {
+    if (root == body) root = first;
+  }
+  WriteGlb(dir / "chain.glb", glb);
+  std::string message;
+  EXPECT_EQ(ErrorField([&] { ImportRiggedAvatar(dir / "chain.glb"); }, &message), "(no InputError)")
+      << message;
+  fs::remove_all(dir);
 }
 
 TEST_F(ImportFigureTest, CorruptGlb) {

@@ -68,8 +68,9 @@ class GltfReader {
            std::to_string(n));
     const int size = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType));
     if (size <= 0) Fail(what + ": bad component type " + std::to_string(a.componentType));
-    std::vector<double> out(a.count * static_cast<size_t>(n), 0.0);
-    if (a.bufferView < 0) return out;  // all zeros by the specification
+    // Sizes are checked before anything is allocated from the claimed count
+    // (ValidateGltfSizes did so for the whole file already).
+    if (a.bufferView < 0) return std::vector<double>(a.count * static_cast<size_t>(n), 0.0);
     if (a.bufferView >= static_cast<int>(m_.bufferViews.size())) Fail(what + ": bad buffer view");
     const tinygltf::BufferView& view = m_.bufferViews[a.bufferView];
     if (view.buffer < 0 || view.buffer >= static_cast<int>(m_.buffers.size()))
@@ -78,12 +79,14 @@ class GltfReader {
     const int stride = a.ByteStride(view);
     if (stride <= 0) Fail(what + ": bad byte stride");
     const size_t begin = view.byteOffset + a.byteOffset;
-    const size_t end_needed =
-        a.count == 0 ? begin
-                     : begin + static_cast<size_t>(stride) * (a.count - 1) + size_t(n) * size;
-    if (end_needed > view.byteOffset + view.byteLength || end_needed > data.size()) {
-      Fail(what + ": accessor " + std::to_string(index) + " runs past its buffer");
+    const size_t limit = std::min<size_t>(view.byteOffset + view.byteLength, data.size());
+    const size_t element = size_t(n) * size;
+    if (a.count > 0 && (begin + element > limit ||
+                        (a.count - 1) > (limit - begin - element) / static_cast<size_t>(stride))) {
+      throw InputError(file_, "accessors[" + std::to_string(index) + "].count",
+                       what + ": accessor " + std::to_string(index) + " runs past its buffer");
     }
+    std::vector<double> out(a.count * static_cast<size_t>(n), 0.0);
     const bool scale = a.normalized || normalise;
     for (size_t k = 0; k < a.count; ++k) {
       const unsigned char* p = data.data() + begin + k * stride;
@@ -177,6 +180,70 @@ Matrix4d NodeLocal(const tinygltf::Node& node) {
   return m;
 }
 
+// Sizes every buffer view and accessor claims, against the bytes that are
+// there, before anything is allocated from them: a view must lie inside its
+// buffer, an accessor's `count` elements (at its stride) inside its view, and
+// an accessor without a view (zeros) may not claim more elements than the
+// input has bytes (`file_bytes` plus its buffers). InputError names the field
+// ("accessors[3].count"). tinygltf itself allocates only what the file holds.
+void ValidateGltfSizes(const tinygltf::Model& model,
+                       const std::string& file,
+                       uintmax_t file_bytes) {
+  uintmax_t input_bytes = file_bytes;
+  for (const tinygltf::Buffer& buffer : model.buffers) input_bytes += buffer.data.size();
+  for (size_t i = 0; i < model.bufferViews.size(); ++i) {
+    const tinygltf::BufferView& view = model.bufferViews[i];
+    const std::string field = "bufferViews[" + std::to_string(i) + "]";
+    if (view.buffer < 0 || view.buffer >= static_cast<int>(model.buffers.size()))
+      throw InputError(file, field + ".buffer", "no buffer " + std::to_string(view.buffer));
+    const size_t buffer_bytes = model.buffers[view.buffer].data.size();
+    if (view.byteOffset > buffer_bytes || view.byteLength > buffer_bytes - view.byteOffset) {
+      throw InputError(file, field + ".byteLength",
+                       "bytes " + std::to_string(view.byteOffset) + " + " +
+                           std::to_string(view.byteLength) + " run past buffer " +
+                           std::to_string(view.buffer) + " (" + std::to_string(buffer_bytes) +
+                           " bytes)");
+    }
+  }
+  for (size_t i = 0; i < model.accessors.size(); ++i) {
+    const tinygltf::Accessor& a = model.accessors[i];
+    const std::string field = "accessors[" + std::to_string(i) + "]";
+    const int components = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type));
+    const int component_bytes =
+        tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType));
+    if (components <= 0) throw InputError(file, field + ".type", "unknown accessor type");
+    if (component_bytes <= 0)
+      throw InputError(file, field + ".componentType", "unknown component type");
+    const uintmax_t element = uintmax_t(components) * component_bytes;
+    const std::string claim =
+        "claims " + std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes";
+    if (a.bufferView < 0) {
+      if (a.count > input_bytes)
+        throw InputError(file, field + ".count",
+                         claim + "; the whole input has " + std::to_string(input_bytes) + " bytes");
+      continue;
+    }
+    if (a.bufferView >= static_cast<int>(model.bufferViews.size()))
+      throw InputError(file, field + ".bufferView",
+                       "no buffer view " + std::to_string(a.bufferView));
+    const tinygltf::BufferView& view = model.bufferViews[a.bufferView];
+    const int stride = a.ByteStride(view);
+    if (stride <= 0)
+      throw InputError(file, "bufferViews[" + std::to_string(a.bufferView) + "].byteStride",
+                       "bad byte stride");
+    if (a.count == 0) continue;
+    const uintmax_t view_bytes = view.byteLength;
+    if (a.byteOffset > view_bytes || element > view_bytes - a.byteOffset ||
+        (a.count - 1) > (view_bytes - a.byteOffset - element) / uintmax_t(stride)) {
+      throw InputError(file, field + ".count",
+                       claim + " (stride " + std::to_string(stride) + ") from byte " +
+                           std::to_string(a.byteOffset) + "; buffer view " +
+                           std::to_string(a.bufferView) + " holds " + std::to_string(view_bytes) +
+                           " bytes");
+    }
+  }
+}
+
 // Reads `path` into `model` (binary glTF when it starts with "glTF"); throws
 // InputError(file, "file") when tinygltf cannot read it.
 void ReadGltfModel(const fs::path& path, const std::string& file, tinygltf::Model& model) {
@@ -205,6 +272,9 @@ void ReadGltfModel(const fs::path& path, const std::string& file, tinygltf::Mode
         file, "file",
         "not a readable glTF file: " + (err.empty() ? std::string("unknown error") : trim(err)));
   if (!warn.empty()) Log().debug("avatar import: {}: {}", file, trim(warn));
+  std::error_code ec;
+  const uintmax_t file_bytes = fs::file_size(path, ec);
+  ValidateGltfSizes(model, file, ec ? 0 : file_bytes);
 }
 
 // The node hierarchy: each node's parent (-1 for a root), checked on
@@ -228,13 +298,19 @@ class GltfNodeTree {
   int Parent(int i) const { return parent_[i]; }
 
   // World transform of node `i`: its ancestors' local transforms composed.
+  // Iterative, so that a deep node chain cannot overflow the stack.
   const Matrix4d& World(int i) {
-    if (state_[i] == 1) reader_.Fail("the node hierarchy has a cycle");
-    if (state_[i] == 0) {
-      state_[i] = 1;
-      world_[i] = parent_[i] >= 0 ? Matrix4d(World(parent_[i]) * NodeLocal(model_.nodes[i]))
-                                  : NodeLocal(model_.nodes[i]);
-      state_[i] = 2;
+    std::vector<int> chain;  // `i` and its ancestors not yet done, child first
+    for (int n = i; n >= 0 && state_[n] != 2; n = parent_[n]) {
+      if (state_[n] == 1) reader_.Fail("the node hierarchy has a cycle");
+      state_[n] = 1;
+      chain.push_back(n);
+    }
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const int n = *it;
+      world_[n] = parent_[n] >= 0 ? Matrix4d(world_[parent_[n]] * NodeLocal(model_.nodes[n]))
+                                  : NodeLocal(model_.nodes[n]);
+      state_[n] = 2;
     }
     return world_[i];
   }

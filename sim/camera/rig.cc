@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include "common/json_reader.h"
 
@@ -29,6 +30,37 @@ std::string CheckDistortionUsable(const Camera& camera) {
   return "";
 }
 
+namespace {
+
+std::string Str(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// A focal length in pixels against the image's `size` along its axis.
+void CheckFocal(const JsonNode& node, double focal, int size, const std::string& axis) {
+  const double lo = kMinFocalPerPixel * size, hi = kMaxFocalPerPixel * size;
+  if (!(focal >= lo && focal <= hi)) {
+    node.Fail("focal length must be in [" + Str(lo) + ", " + Str(hi) + "] px (" +
+              Str(kMinFocalPerPixel) + " to " + Str(kMaxFocalPerPixel) + " x the image " + axis +
+              "; got " + Str(focal) + ")");
+  }
+}
+
+// Three coordinates, each within +-kMaxRigCoordinateM.
+Eigen::Vector3d Coordinates(const JsonNode& node) {
+  const Eigen::Vector3d v = node.Vec3();
+  for (int k = 0; k < 3; ++k) {
+    if (std::abs(v[k]) > kMaxRigCoordinateM) {
+      node[k].Fail("must be within +-" + Str(kMaxRigCoordinateM) + " m");
+    }
+  }
+  return v;
+}
+
+}  // namespace
+
 Rig LoadRig(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
   root.CheckKeys({"format", "name", "scene", "description", "cameras"});
@@ -48,8 +80,8 @@ Rig LoadRig(const std::filesystem::path& path) {
                  "up", "fps", "exposure_ms", "sensor", "description"});
     Camera cam;
     cam.name = c.GetString("name");
-    if (cam.name.empty() || cam.name.find_first_of("/ \t") != std::string::npos) {
-      c["name"].Fail("must be a non-empty name without spaces or '/'");
+    if (const std::string problem = CameraNameProblem(cam.name); !problem.empty()) {
+      c["name"].Fail(problem);
     }
     if (!names.insert(cam.name).second) c["name"].Fail("duplicate camera name '" + cam.name + "'");
     cam.width = c.GetInt("width", 320);
@@ -62,17 +94,24 @@ Rig LoadRig(const std::filesystem::path& path) {
     cam.cy = c.GetDouble("cy");
     if (cam.fx <= 0) c["fx"].Fail("focal length must be positive (got " + std::to_string(cam.fx) + ")");
     if (cam.fy <= 0) c["fy"].Fail("focal length must be positive (got " + std::to_string(cam.fy) + ")");
+    CheckFocal(c["fx"], cam.fx, cam.width, "width");
+    CheckFocal(c["fy"], cam.fy, cam.height, "height");
     if (cam.cx < 0 || cam.cx > cam.width - 1) c["cx"].Fail("principal point outside the image");
     if (cam.cy < 0 || cam.cy > cam.height - 1) c["cy"].Fail("principal point outside the image");
     const std::vector<double> dist = c["dist"].Numbers();
     if (dist.size() != 5) c["dist"].Fail("expected 5 numbers: k1 k2 p1 p2 k3");
-    for (int k = 0; k < 5; ++k) cam.dist[k] = dist[k];
+    for (int k = 0; k < 5; ++k) {
+      if (std::abs(dist[k]) > kMaxDistortionCoefficient) {
+        c["dist"][k].Fail("|coefficient| must be at most " + Str(kMaxDistortionCoefficient));
+      }
+      cam.dist[k] = dist[k];
+    }
     if (const std::string problem = CheckDistortionUsable(cam); !problem.empty()) {
       c["dist"].Fail(problem);
     }
-    const Eigen::Vector3d position = c.GetVec3("position");
-    const Eigen::Vector3d look_at = c.GetVec3("look_at");
-    const Eigen::Vector3d up = c.Has("up") ? c.GetVec3("up") : Eigen::Vector3d(0, 0, 1);
+    const Eigen::Vector3d position = Coordinates(c["position"]);
+    const Eigen::Vector3d look_at = Coordinates(c["look_at"]);
+    const Eigen::Vector3d up = c.Has("up") ? Coordinates(c["up"]) : Eigen::Vector3d(0, 0, 1);
     const auto cam_from_world = LookAt(position, look_at, up);
     if (!cam_from_world) c["look_at"].Fail("view direction is zero or parallel to 'up'");
     cam.cam_from_world = *cam_from_world;

@@ -24,8 +24,20 @@ struct Rig {
   std::filesystem::path source;
 };
 
+// Physical ranges of a rig's numbers, beyond the format's own checks:
+// fx in [kMinFocalPerPixel, kMaxFocalPerPixel] x width, fy the same x height
+// (fields of view from about 0.6 to 178 degrees);
+inline constexpr double kMinFocalPerPixel = 0.01;
+inline constexpr double kMaxFocalPerPixel = 100.0;
+// |each distortion coefficient| <= this (the presets use <= 0.22);
+inline constexpr double kMaxDistortionCoefficient = 100.0;
+// |each coordinate| of position, look_at and up <= this, metres.
+inline constexpr double kMaxRigCoordinateM = 1000.0;
+
 // Loads and validates a rig; every problem throws InputError naming the file and
-// field (e.g. "cameras[1].fx: must be positive").
+// field (e.g. "cameras[1].fx: must be positive"). Camera names must pass
+// CameraNameProblem (sequence_format/calibration.h): [A-Za-z0-9_-], 1-64
+// characters, not starting with '-'.
 Rig LoadRig(const std::filesystem::path& path);
 
 // Checks that the distortion does not fold inside the image and that every

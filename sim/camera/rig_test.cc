@@ -117,5 +117,40 @@ TEST_F(RigErrorTest, NamesTheField) {
             "(no error)");
 }
 
+// Issue 27.3: camera names "..", ".", 300 characters or non-ASCII reached the
+// file system and OpenCV (exit 1 with a raw message); only [A-Za-z0-9_-],
+// 1-64 characters, not starting with '-', are accepted.
+TEST_F(RigErrorTest, CameraNamesAreFromTheSafeSet) {
+  const std::string rest = R"("fx": 300, "fy": 300, "cx": 160, "cy": 120, )" + dist_ + ", " + pose_;
+  auto named = [&](const std::string& name) {
+    return R"({"format": "irbench.rig/1", "cameras": [{"name": ")" + name + "\", " + rest + "}]}";
+  };
+  for (const std::string& bad : std::vector<std::string>{"..", ".", std::string(300, 'a'), std::string(65, 'b'), "kamera_\u00fc",
+                                "cam\u00e9ra", "-front", "a b", "a/b", "a.b", "", "c$d", "a:b"}) {
+    EXPECT_EQ(ErrorOf(named(bad)), "cameras[0].name") << bad;
+  }
+  for (const std::string& good : std::vector<std::string>{"front_left", "Cam-01", "c", std::string(64, 'z'), "_x", "0"}) {
+    EXPECT_EQ(ErrorOf(named(good)), "(no error)") << good;
+  }
+}
+
+// Issue 27.3: fx = 1e308 rendered black frames with exit 0; focal lengths,
+// distortion and coordinates have physical ranges.
+TEST_F(RigErrorTest, NumbersOutsidePhysicalRangesNameTheField) {
+  const std::string pp = R"("cx": 160, "cy": 120, )";
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 1e308, "fy": 300, )" + pp + dist_ + ", " + pose_)), "cameras[0].fx");
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 32001, "fy": 300, )" + pp + dist_ + ", " + pose_)), "cameras[0].fx");
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 300, "fy": 1e-300, )" + pp + dist_ + ", " + pose_)), "cameras[0].fy");
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 300, "fy": 300, )" + pp + R"("dist": [0, 0, 1e300, 0, 0], )" + pose_)),
+            "cameras[0].dist[2]");
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 300, "fy": 300, )" + pp + dist_ +
+                           R"(, "position": [0, 1e308, 1], "look_at": [0, 0, 1])")),
+            "cameras[0].position[1]");
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 300, "fy": 300, )" + pp + dist_ + ", " + pose_ + R"(, "up": [0, 0, 1e9])")),
+            "cameras[0].up[2]");
+  // The bounds themselves are fine: 100 x 320 and 0.01 x 240 px.
+  EXPECT_EQ(ErrorOf(Camera(R"("fx": 32000, "fy": 2.4, )" + pp + dist_ + ", " + pose_)), "(no error)");
+}
+
 }  // namespace
 }  // namespace irbench

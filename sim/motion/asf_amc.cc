@@ -135,6 +135,26 @@ class LineReader {
     if (!std::isfinite(*value)) Fail(line.number, what + " '" + token + "' is not finite");
     return *value;
   }
+  // A finite number with |value| <= `limit` (`unit` names it in the message).
+  double Bounded(const Line& line,
+                 size_t k,
+                 const std::string& what,
+                 double limit,
+                 const std::string& unit) const {
+    const double value = Number(line, k, what);
+    if (std::abs(value) > limit) {
+      std::ostringstream text;
+      text << what << " '" << line.tokens[k] << "' is beyond +-" << limit << " " << unit;
+      Fail(line.number, text.str());
+    }
+    return value;
+  }
+  double Length(const Line& line, size_t k, const std::string& what) const {
+    return Bounded(line, k, what, kMaxAsfAmcLength, "file units");
+  }
+  double Angle(const Line& line, size_t k, const std::string& what) const {
+    return Bounded(line, k, what, kMaxAsfAmcAngleDeg, "(angle unit)");
+  }
   // Exactly `count` values after the keyword.
   void ExpectValues(const Line& line, size_t count) const {
     if (line.tokens.size() != count + 1) {
@@ -265,7 +285,12 @@ class AsfParser : public LineReader {
     } else if (key == "length") {
       ExpectValues(line, 1);
       const double length = Number(line, 1, "length");
-      if (!(length > 0)) Fail(line.number, "length unit must be positive");
+      if (!(length >= kMinAsfLengthUnit && length <= kMaxAsfLengthUnit)) {
+        std::ostringstream text;
+        text << "length unit must be in [" << kMinAsfLengthUnit << ", " << kMaxAsfLengthUnit
+             << "], got '" << line.tokens[1] << "'";
+        Fail(line.number, text.str());
+      }
       skeleton_.length_unit = length;
     } else if (key == "angle") {
       ExpectValues(line, 1);
@@ -303,10 +328,10 @@ class AsfParser : public LineReader {
       raw_axes_[0].order = AxisOrder(line, 1);
     } else if (key == "position") {
       ExpectValues(line, 3);
-      for (int k = 0; k < 3; ++k) skeleton_.root_position[k] = Number(line, k + 1, "position");
+      for (int k = 0; k < 3; ++k) skeleton_.root_position[k] = Length(line, k + 1, "position");
     } else if (key == "orientation") {
       ExpectValues(line, 3);
-      for (int k = 0; k < 3; ++k) raw_axes_[0].angles[k] = Number(line, k + 1, "orientation");
+      for (int k = 0; k < 3; ++k) raw_axes_[0].angles[k] = Angle(line, k + 1, "orientation");
     } else {
       Fail(line.number,
            "unknown :root entry '" + key + "' (expected order, axis, position or orientation)");
@@ -344,17 +369,17 @@ class AsfParser : public LineReader {
       name_line_ = line.number;
     } else if (key == "direction") {
       ExpectValues(line, 3);
-      for (int k = 0; k < 3; ++k) bone_.direction[k] = Number(line, k + 1, "direction");
+      for (int k = 0; k < 3; ++k) bone_.direction[k] = Length(line, k + 1, "direction");
       has_direction_ = true;
       direction_line_ = line.number;
     } else if (key == "length") {
       ExpectValues(line, 1);
-      bone_.length = Number(line, 1, "length");
+      bone_.length = Length(line, 1, "length");
       if (bone_.length < 0) Fail(line.number, "bone length must not be negative");
       has_length_ = true;
     } else if (key == "axis") {
       ExpectValues(line, 4);
-      for (int k = 0; k < 3; ++k) bone_axis_.angles[k] = Number(line, k + 1, "axis angle");
+      for (int k = 0; k < 3; ++k) bone_axis_.angles[k] = Angle(line, k + 1, "axis angle");
       bone_axis_.order = AxisOrder(line, 4);
     } else if (key == "dof") {
       bone_.dofs.clear();
@@ -626,8 +651,16 @@ class AmcParser : public LineReader {
       }
       std::vector<double>& values = frames.back()[b];
       for (size_t k = 0; k < dofs.size(); ++k) {
-        values[k] = Number(line, k + 1, "value");
-        if (IsRotation(dofs[k])) values[k] *= to_radians;
+        if (IsRotation(dofs[k])) {
+          // The limit in the file's unit: degrees, or radians for :RADIANS.
+          const bool radians = to_radians == 1.0;
+          const double limit =
+              radians ? kMaxAsfAmcAngleDeg * std::numbers::pi / 180.0 : kMaxAsfAmcAngleDeg;
+          values[k] = Bounded(line, k + 1, "rotation", limit, radians ? "radians" : "degrees");
+          values[k] *= to_radians;
+        } else {
+          values[k] = Length(line, k + 1, "value");
+        }
       }
     }
     if (frames.empty()) Fail(line_count_, "the AMC file has no frames");
@@ -692,6 +725,19 @@ void Solve(const AsfSkeleton& skeleton,
   }
 }
 
+// The clip names a leaf bone's tip "<bone>_end": a bone already named so
+// would give two joints one name.
+void CheckTipNames(const AsfSkeleton& skeleton, const std::string& asf_name) {
+  for (size_t b = 1; b < skeleton.bones.size(); ++b) {
+    if (!skeleton.bones[b].children.empty()) continue;
+    const auto it = skeleton.index.find(skeleton.bones[b].name + "_end");
+    if (it == skeleton.index.end()) continue;
+    throw InputError(asf_name, "line " + std::to_string(skeleton.bones[it->second].line),
+                     "bone name '" + it->first + "' is also the name of bone '" +
+                         skeleton.bones[b].name + "''s tip joint");
+  }
+}
+
 }  // namespace
 
 MocapClip ParseAsfAmc(const std::string& asf_text,
@@ -703,6 +749,7 @@ MocapClip ParseAsfAmc(const std::string& asf_text,
     throw InputError(amc_name, "frame_time", "frame time must be positive");
   }
   const AsfSkeleton skeleton = AsfParser(asf_text, asf_name).Parse();
+  CheckTipNames(skeleton, asf_name);
   const AmcFrames frames = AmcParser(amc_text, amc_name, skeleton, asf_name).Parse();
 
   MocapClip clip;

@@ -22,14 +22,28 @@ namespace irbench {
 // CMU captures at 120 Hz; an AMC file does not say its rate.
 inline constexpr double kCmuFrameTime = 1.0 / 120.0;
 
+// Physical limits; a value beyond them is refused as an input error (a corrupt
+// or crafted file, not a capture). Lengths in file units (CMU: inches / 0.45).
+// |ASF position, direction component, bone length| and |AMC translation or
+// `l` value|.
+inline constexpr double kMaxAsfAmcLength = 1e5;
+// |ASF axis / orientation angle| in the file's angle unit, and |AMC rotation|
+// in degrees (a :RADIANS file's values are converted first).
+inline constexpr double kMaxAsfAmcAngleDeg = 1e6;
+// `:units length` (file units per inch × 0.45 in CMU's convention).
+inline constexpr double kMinAsfLengthUnit = 1e-4;
+inline constexpr double kMaxAsfLengthUnit = 1e4;
+
 // Parses an ASF skeleton file and an AMC motion file into a MocapClip: one
 // joint per ASF bone at the bone's start (so "lradius" sits at the elbow, as
 // amc2bvh places it), "root", and "<bone>_end" at the tip of every bone without
 // children. Positions are in file units (metres_per_unit = 0.0254 / `:units
 // length`, the CMU inch convention) and the file's axes; rotations are world
 // deltas from the rest pose (every dof zero). `frame_time` in seconds.
-// Throws InputError(file, "line N", ...) for any bad input, (file, "file", ...)
-// for a file that cannot be read.
+// Throws InputError(file, "line N", ...) for any bad input (among them two
+// bones with one name, a bone named like another's "<bone>_end" tip, a
+// non-finite number or one beyond the limits above), (file, "file", ...) for a
+// file that cannot be read.
 MocapClip LoadAsfAmc(const std::filesystem::path& asf,
                      const std::filesystem::path& amc,
                      double frame_time = kCmuFrameTime);

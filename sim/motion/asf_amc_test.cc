@@ -392,6 +392,50 @@ TEST(AsfAmcTest, AsfErrorsNameTheLine) {
               "inside the bone block begun at line " + std::to_string(LineOf(kAsf, "id 1") - 1));
 }
 
+// Issue 27.3: two bones with one name make the skeleton ambiguous; so does a
+// bone named like another leaf bone's tip joint ("<bone>_end").
+TEST(AsfAmcTest, DuplicateBoneNamesAreRefused) {
+  const std::string asf_file = "test.asf";
+  ExpectError(Replace(kAsf, "name lradius", "name lhumerus"), kAmc, asf_file,
+              LineOf(kAsf, "name lradius"), "bone name 'lhumerus' used twice");
+  ExpectError(Replace(kAsf, "name lowerback", "name root"), kAmc, asf_file,
+              LineOf(kAsf, "name lowerback"), "'root' used twice");
+  // lradius is a leaf: its tip is the clip joint "lradius_end".
+  const std::string tip = ReplaceAll(kAsf, "lowerback", "lradius_end");
+  ExpectError(tip, kAmc, asf_file, LineOf(kAsf, "id 3") - 1,
+              "bone name 'lradius_end' is also the name of bone 'lradius''s tip joint");
+}
+
+// Issue 27.3: AMC and ASF values that are not finite or physically absurd
+// (a rotation of -1e308 degrees wrote 'nan' into the truth) are refused
+// naming the file and line.
+TEST(AsfAmcTest, AbsurdValuesAreRefused) {
+  const std::string amc_file = "dir/test_01.amc", asf_file = "test.asf";
+  const int lradius = LineOf(kAmc, "lradius 60");
+  ExpectError(kAsf, Replace(kAmc, "lradius 60", "lradius -1e308"), amc_file, lradius,
+              "rotation '-1e308' is beyond +-1e+06 degrees");
+  ExpectError(kAsf, Replace(kAmc, "lradius 60", "lradius 1e400"), amc_file, lradius, "rotation");
+  ExpectError(kAsf, Replace(kAmc, "root 0.5 -1 2 0 0 90", "root 0.5 -1e6 2 0 0 90"), amc_file,
+              LineOf(kAmc, "root 0.5 -1 2 0 0 90"), "beyond +-100000 file units");
+  // In radians the limit is the same angle: 20000 rad is about 1.15e6 degrees.
+  const std::string radians = Replace(kAmc, ":DEGREES", ":RADIANS");
+  ExpectError(kAsf, Replace(radians, "lradius 60", "lradius 20000"), amc_file, lradius,
+              "beyond +-17453");
+  EXPECT_NO_THROW(Parse(kAsf, Replace(radians, "lradius 60", "lradius 17000")));
+  EXPECT_NO_THROW(Parse(kAsf, Replace(kAmc, "lradius 60", "lradius -720")));
+  // The skeleton's numbers.
+  ExpectError(Replace(kAsf, "length 8\n", "length 1e300\n"), kAmc, asf_file, LineOf(kAsf, "length 8\n"),
+              "length '1e300' is beyond");
+  ExpectError(Replace(kAsf, "position 1 2 3", "position 1 -2e5 3"), kAmc, asf_file,
+              LineOf(kAsf, "position 1 2 3"), "position '-2e5'");
+  ExpectError(Replace(kAsf, "axis 0 45 0 XYZ", "axis 0 4.5e7 0 XYZ"), kAmc, asf_file,
+              LineOf(kAsf, "axis 0 45 0 XYZ"), "axis angle '4.5e7'");
+  ExpectError(Replace(kAsf, "direction 0 -1 0", "direction 0 -1e300 0"), kAmc, asf_file,
+              LineOf(kAsf, "direction 0 -1 0"), "direction");
+  ExpectError(Replace(kAsf, "length 0.45", "length 1e-300"), kAmc, asf_file,
+              LineOf(kAsf, "length 0.45"), "length unit must be in");
+}
+
 TEST(AsfAmcTest, TranslationAndLengthDofs) {
   // `tx` moves the bone's start along its local x (world y for lhumerus) before
   // its rotation, as in the CMU viewer; `l` adds to the length.

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <sstream>
+#include <unordered_map>
 
 #include "common/error.h"
 #include "sim/body/avatar.h"
@@ -49,7 +50,7 @@ class Parser {
     Expect("HIERARCHY");
     const Token root = Next("ROOT");
     if (root.text != "ROOT") Fail(root.line, "expected ROOT, got '" + root.text + "'");
-    ParseJoint(bvh, -1);
+    ParseJoint(bvh, -1, 1);
     const Token motion = Next("MOTION");
     if (motion.text != "MOTION") {
       Fail(motion.line, "expected MOTION after the hierarchy, got '" + motion.text + "'");
@@ -64,15 +65,25 @@ class Parser {
     if (frame_key.text != "Frame" || time_key.text != "Time:") Fail(frame_key.line, "expected 'Frame Time:'");
     const Token time = Next("a frame time");
     bvh.frame_time = Number(time);
-    if (!(bvh.frame_time > 0)) Fail(time.line, "frame time must be positive");
-    // Frame lines: each must hold exactly channel_count values.
+    if (!(bvh.frame_time >= kMinBvhFrameTime && bvh.frame_time <= kMaxBvhFrameTime)) {
+      Fail(time.line, "frame time must be in [" + Str(kMinBvhFrameTime) + ", " +
+                          Str(kMaxBvhFrameTime) + "] s, got '" + time.text + "'");
+    }
+    const std::vector<BvhChannel> kinds = ChannelKinds(bvh);
+    // Frame lines: each must hold exactly channel_count values. The count
+    // claimed by 'Frames:' reserves no more than the file can hold.
     const size_t frames = static_cast<size_t>(n);
-    bvh.frames.reserve(frames);
+    bvh.frames.reserve(std::min(frames, tokens_.size() - pos_));
     while (pos_ < tokens_.size()) {
       const int line = tokens_[pos_].line;
       std::vector<double> values;
       values.reserve(bvh.channel_count);
-      while (pos_ < tokens_.size() && tokens_[pos_].line == line) values.push_back(Number(tokens_[pos_++]));
+      while (pos_ < tokens_.size() && tokens_[pos_].line == line) {
+        const Token& t = tokens_[pos_++];
+        const double v = Number(t);
+        if (values.size() < kinds.size()) CheckChannelValue(t, kinds[values.size()], v);
+        values.push_back(v);
+      }
       if (static_cast<int>(values.size()) != bvh.channel_count) {
         Fail(line, "frame " + std::to_string(bvh.frames.size()) + " has " + std::to_string(values.size()) +
                        " values; the hierarchy has " + std::to_string(bvh.channel_count) + " channels");
@@ -91,14 +102,21 @@ class Parser {
   }
 
  private:
-  void ParseJoint(BvhFile& bvh, int parent) {
+  // Joint at nesting level `depth` (the root is 1); recursion is bounded by
+  // kMaxBvhDepth.
+  void ParseJoint(BvhFile& bvh, int parent, int depth) {
     const Token name = Next("a joint name");
+    if (depth > kMaxBvhDepth) {
+      Fail(name.line, "joint '" + name.text + "' is nested deeper than " +
+                          std::to_string(kMaxBvhDepth) + " levels");
+    }
     BvhJoint joint;
     joint.name = name.text;
     joint.parent = parent;
+    AddName(name.text, name.line);
     Expect("{");
     Expect("OFFSET");
-    for (int k = 0; k < 3; ++k) joint.offset[k] = Number(Next("an OFFSET value"));
+    ReadOffset(joint.offset);
     const Token channels = Next("CHANNELS");
     if (channels.text != "CHANNELS") {
       Fail(channels.line, "joint '" + joint.name + "' has no CHANNELS line (got '" + channels.text + "')");
@@ -131,7 +149,7 @@ class Parser {
       const Token t = Next("'}'");
       if (t.text == "}") break;
       if (t.text == "JOINT") {
-        ParseJoint(bvh, index);
+        ParseJoint(bvh, index, depth + 1);
       } else if (t.text == "End") {
         const Token site = Next("Site");
         if (site.text != "Site") Fail(site.line, "expected 'End Site'");
@@ -140,9 +158,10 @@ class Parser {
         end.parent = index;
         end.end_site = true;
         end.first_channel = bvh.channel_count;
+        AddName(end.name, site.line);
         Expect("{");
         Expect("OFFSET");
-        for (int k = 0; k < 3; ++k) end.offset[k] = Number(Next("an OFFSET value"));
+        ReadOffset(end.offset);
         Expect("}");
         bvh.joints.push_back(end);
       } else {
@@ -171,10 +190,55 @@ class Parser {
   [[noreturn]] void Fail(int line, const std::string& message) const {
     throw InputError(file_, "line " + std::to_string(line), message);
   }
+  static std::string Str(double v) {
+    std::ostringstream out;
+    out << v;
+    return out.str();
+  }
+
+  // Registers a joint name; a second joint with it is an error (it would make
+  // the skeleton ambiguous: a retarget could put a knee above the hip).
+  void AddName(const std::string& name, int line) {
+    const auto [it, inserted] = name_line_.emplace(name, line);
+    if (!inserted) {
+      Fail(line, "joint name '" + name + "' is used twice (first at line " +
+                     std::to_string(it->second) + ")");
+    }
+  }
+  void ReadOffset(Eigen::Vector3d& offset) {
+    for (int k = 0; k < 3; ++k) {
+      const Token t = Next("an OFFSET value");
+      offset[k] = Number(t);
+      if (std::abs(offset[k]) > kMaxBvhPosition) {
+        Fail(t.line,
+             "OFFSET value '" + t.text + "' is beyond +-" + Str(kMaxBvhPosition) + " (file units)");
+      }
+    }
+  }
+  // Each channel's kind, in frame-line order.
+  static std::vector<BvhChannel> ChannelKinds(const BvhFile& bvh) {
+    std::vector<BvhChannel> kinds;
+    kinds.reserve(bvh.channel_count);
+    for (const BvhJoint& j : bvh.joints)
+      kinds.insert(kinds.end(), j.channels.begin(), j.channels.end());
+    return kinds;
+  }
+  void CheckChannelValue(const Token& t, BvhChannel kind, double v) const {
+    if (kind >= BvhChannel::kXrotation) {
+      if (std::abs(v) > kMaxBvhRotationDeg) {
+        Fail(t.line,
+             "rotation '" + t.text + "' is beyond +-" + Str(kMaxBvhRotationDeg) + " degrees");
+      }
+    } else if (std::abs(v) > kMaxBvhPosition) {
+      Fail(t.line,
+           "position '" + t.text + "' is beyond +-" + Str(kMaxBvhPosition) + " (file units)");
+    }
+  }
 
   std::vector<Token> tokens_;
   size_t pos_ = 0;
   std::string file_;
+  std::unordered_map<std::string, int> name_line_;  // joint name -> its line
 };
 
 Eigen::Matrix3d AxisRotation(BvhChannel c, double degrees) {

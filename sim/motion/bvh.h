@@ -33,7 +33,24 @@ struct BvhFile {
   std::vector<std::vector<double>> frames;  // channel values; rotations in degrees
 };
 
-// Parses BVH text; errors name `file_name` and "line N".
+// Physical limits a BVH must respect; anything beyond is refused as input
+// error (a crafted or corrupt file, not a capture).
+// Joints nested deeper than this (a real skeleton has < 30 levels).
+inline constexpr int kMaxBvhDepth = 256;
+// |OFFSET| components and position channel values, in the file's units (CMU
+// files are in inches or centimetres: 1e5 is a kilometre or more).
+inline constexpr double kMaxBvhPosition = 1e5;
+// |rotation channel value|, degrees (a joint that turned a million degrees).
+inline constexpr double kMaxBvhRotationDeg = 1e6;
+// Frame Time, seconds: at most one frame a minute, at least 1 MHz.
+inline constexpr double kMinBvhFrameTime = 1e-6;
+inline constexpr double kMaxBvhFrameTime = 60.0;
+
+// Parses BVH text; errors name `file_name` and "line N". Refused: nesting
+// deeper than kMaxBvhDepth; two joints with one name (End Sites are named
+// "<parent>_end" and count too); non-finite numbers; positions and rotations
+// beyond the limits above; a frame time outside [kMinBvhFrameTime,
+// kMaxBvhFrameTime].
 BvhFile ParseBvh(const std::string& text, const std::string& file_name);
 BvhFile LoadBvh(const std::filesystem::path& path);
 // Writes BVH text (tabs, LF, values with 6 decimals).

@@ -119,6 +119,88 @@ TEST(BvhTest, BadInputNamesTheLine) {
   EXPECT_EQ(LineOf(Replace(good, "Frames:\t2", "Frames:\t3")), 20);
 }
 
+// The InputError of parsing `text`; fails the test when there is none.
+InputError ErrorOf(const std::string& text) {
+  try {
+    ParseBvh(text, "bad.bvh");
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error";
+  return InputError("", "", "");
+}
+
+// Issue 27.3: a chain of 15,000 nested joints overflowed the recursive
+// parser's stack (SIGSEGV); nesting is capped at kMaxBvhDepth levels.
+TEST(BvhTest, DeepNestingIsAnErrorNotACrash) {
+  const int depth = 15000;
+  std::string text = "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n";
+  for (int j = 1; j < depth; ++j) {
+    text += "JOINT j" + std::to_string(j) + "\n{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n";
+  }
+  for (int j = 0; j < depth; ++j) text += "}\n";
+  text += "MOTION\nFrames: 0\nFrame Time: 0.01\n";
+  const InputError e = ErrorOf(text);
+  // Joint j256 (level 257) is named on line 2 + 4 * 256.
+  EXPECT_EQ(e.field(), "line " + std::to_string(2 + 4 * kMaxBvhDepth)) << e.what();
+  EXPECT_NE(e.message().find("deeper than 256"), std::string::npos) << e.what();
+  // At the cap itself the file is fine.
+  std::string ok = "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 0\n";
+  for (int j = 1; j < kMaxBvhDepth; ++j) ok += "JOINT j" + std::to_string(j) + "\n{\nOFFSET 0 1 0\nCHANNELS 0\n";
+  for (int j = 0; j < kMaxBvhDepth; ++j) ok += "}\n";
+  ok += "MOTION\nFrames: 0\nFrame Time: 0.01\n";
+  EXPECT_EQ(ParseBvh(ok, "ok.bvh").joints.size(), static_cast<size_t>(kMaxBvhDepth));
+}
+
+// Issue 27.3: two joints with one name were accepted (a knee could end up
+// above the hip in the truth); refused naming the line and the name.
+TEST(BvhTest, DuplicateJointNamesAreRefused) {
+  const std::string good = kSmallBvh;
+  InputError e = ErrorOf(Replace(good, "JOINT Arm", "JOINT Hips"));
+  EXPECT_EQ(e.file(), "bad.bvh");
+  EXPECT_EQ(e.field(), "line 6") << e.what();
+  EXPECT_NE(e.message().find("'Hips'"), std::string::npos) << e.what();
+  EXPECT_NE(e.message().find("line 2"), std::string::npos) << e.what();
+  // A joint named like another joint's End Site ("Hips_end", line 6).
+  e = ErrorOf(Replace(good, "\tJOINT Arm", "\tEnd Site\n\t{\n\t\tOFFSET 0 1 0\n\t}\n\tJOINT Hips_end"));
+  EXPECT_EQ(e.field(), "line 10") << e.what();
+  EXPECT_NE(e.message().find("'Hips_end'"), std::string::npos) << e.what();
+}
+
+// Issue 27.3: -1e308 in a rotation channel was accepted and wrote 'nan' into
+// the truth; non-finite and absurd values are refused naming the line.
+TEST(BvhTest, AbsurdValuesAreRefused) {
+  const std::string good = kSmallBvh;
+  const std::string frame0 = "1 2 3 0 0 0 90 0 0\n";
+  auto message_at = [&](const std::string& text, int line) {
+    const InputError e = ErrorOf(text);
+    EXPECT_EQ(e.field(), "line " + std::to_string(line)) << e.what();
+    return e.message();
+  };
+  EXPECT_NE(message_at(Replace(good, frame0, "1 2 3 -1e308 0 0 90 0 0\n"), 19).find("rotation"),
+            std::string::npos);
+  EXPECT_NE(message_at(Replace(good, frame0, "1 2 3 0 0 0 90 0 1e7\n"), 19).find("degrees"),
+            std::string::npos);
+  message_at(Replace(good, frame0, "1 2 3 0 inf 0 90 0 0\n"), 19);
+  message_at(Replace(good, frame0, "1 2 3 0 0 0 90 -nan 0\n"), 19);
+  message_at(Replace(good, frame0, "1 2 3 0 0 0 90 0 1e400\n"), 19);
+  EXPECT_NE(message_at(Replace(good, frame0, "1 -2e5 3 0 0 0 90 0 0\n"), 19).find("position"),
+            std::string::npos);
+  EXPECT_NE(message_at(Replace(good, "OFFSET 10 0 0", "OFFSET 10 0 1e300"), 8).find("OFFSET"),
+            std::string::npos);
+  message_at(Replace(good, "Frame Time:\t0.0083333", "Frame Time:\t1e9"), 18);
+  message_at(Replace(good, "Frame Time:\t0.0083333", "Frame Time:\t1e-300"), 18);
+  // Within the limits: a large but real rotation and position.
+  EXPECT_NO_THROW(ParseBvh(Replace(good, frame0, "1e4 2 3 7200 0 0 90 0 -999999\n"), "ok.bvh"));
+}
+
+// A 'Frames:' count far beyond the file's lines is an error without first
+// reserving room for that many frames.
+TEST(BvhTest, HugeFrameCountIsAnErrorWithoutAllocating) {
+  const InputError e = ErrorOf(Replace(kSmallBvh, "Frames:\t2", "Frames:\t99999999"));
+  EXPECT_EQ(e.field(), "line 20") << e.what();
+}
+
 Avatar Person(const std::string& name) {
   return LoadAvatar(fs::path(IRBENCH_SOURCE_DIR) / "avatars" / (name + ".json"));
 }

@@ -16,6 +16,32 @@ Material ReadMaterial(const JsonNode& node, const std::string& key, float fallba
   return Material::Of(ReadReflectance(node[key]));
 }
 
+// Every number under `node` (a number or arrays/objects of them, `depth`
+// levels deep at most: deeper shapes are the format readers' to refuse)
+// within +-kMaxSceneCoordinateM.
+void CheckExtent(const JsonNode& node, int depth = 3) {
+  const nlohmann::json& raw = node.raw();
+  if (depth < 0) return;
+  if (raw.is_number()) {
+    const double v = node.Number();
+    if (std::abs(v) > kMaxSceneCoordinateM) {
+      node.Fail("must be within +-" + std::to_string(static_cast<int>(kMaxSceneCoordinateM)) +
+                " m (got " + raw.dump() + ")");
+    }
+  } else if (raw.is_array()) {
+    for (size_t i = 0; i < node.Size(); ++i) CheckExtent(node[i], depth - 1);
+  } else if (raw.is_object()) {
+    for (const std::string& key : node.Keys()) CheckExtent(node[key], depth - 1);
+  }
+}
+
+// CheckExtent on each of `keys` that `node` has.
+void CheckExtents(const JsonNode& node, const std::vector<std::string>& keys) {
+  for (const std::string& key : keys) {
+    if (node.Has(key)) CheckExtent(node[key]);
+  }
+}
+
 void CheckBox(const JsonNode& node, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
   if ((max - min).minCoeff() <= 0) node["max"].Fail("must exceed 'min' on every axis");
 }
@@ -23,6 +49,8 @@ void CheckBox(const JsonNode& node, const Eigen::Vector3d& min, const Eigen::Vec
 // A scene file's screen: its surface (sequence_format/screens.h, shared with
 // calib/screens.json) and how it renders.
 ScreenSurface ReadScreen(const JsonNode& s, Material* material) {
+  CheckExtents(s,
+               {"origin", "right", "up", "width", "height", "center_xy", "radius", "z", "targets"});
   ScreenSurface screen = ReadScreenSurface(s, TargetForm::kScreenCoordinates, {"albedo", "content_radiance", "description"});
   *material = ReadMaterial(s, "albedo", 0.8f);
   // The near-IR radiance the projected content adds (projectors leak near IR);
@@ -32,6 +60,33 @@ ScreenSurface ReadScreen(const JsonNode& s, Material* material) {
     s["content_radiance"].Fail("must be in [0, 10]");
   }
   return screen;
+}
+
+// One of the scene's near-IR illuminators.
+IrLight ReadLight(const JsonNode& l) {
+  l.CheckKeys(
+      {"name", "position", "look_at", "cone_deg", "power", "wavelength_nm", "size_m", "shadows"});
+  CheckExtents(l, {"position", "look_at"});
+  IrLight light;
+  light.name = l.GetString("name");
+  light.position = l.GetVec3("position");
+  const Eigen::Vector3d dir = l.GetVec3("look_at") - light.position;
+  if (dir.norm() < 1e-9) l["look_at"].Fail("must differ from 'position'");
+  light.direction = dir.normalized();
+  light.cone_deg = l.GetDouble("cone_deg", 60.0);
+  if (light.cone_deg <= 0 || light.cone_deg > 180) l["cone_deg"].Fail("must be in (0, 180]");
+  light.power = l.GetDouble("power", 1.0);
+  if (!(light.power >= 0 && light.power <= kMaxLightPower)) {
+    l["power"].Fail("must be in [0, " + std::to_string(static_cast<int>(kMaxLightPower)) + "]");
+  }
+  light.wavelength_nm = l.GetDouble("wavelength_nm", 850.0);
+  if (light.wavelength_nm != 850.0 && light.wavelength_nm != 940.0) {
+    l["wavelength_nm"].Fail("must be 850 or 940");
+  }
+  light.size_m = l.GetDouble("size_m", 0.0);
+  if (light.size_m < 0 || light.size_m > 5) l["size_m"].Fail("must be in [0, 5] m");
+  light.casts_shadows = l.GetBool("shadows", true);
+  return light;
 }
 
 }  // namespace
@@ -46,12 +101,16 @@ Scene LoadScene(const std::filesystem::path& path) {
   if (root.Has("stage")) {
     const JsonNode stage = root["stage"];
     stage.CheckKeys({"center", "size"});
+    CheckExtents(stage, {"center", "size"});
     scene.stage_center = stage["center"].Vec2();
     scene.stage_size = stage["size"].Vec2();
     if (scene.stage_size.minCoeff() <= 0) stage["size"].Fail("must be positive");
   }
   scene.ambient = root.GetDouble("ambient", 0.3);
-  if (scene.ambient < 0) root["ambient"].Fail("must be non-negative");
+  if (!(scene.ambient >= 0 && scene.ambient <= kMaxSceneAmbient)) {
+    root["ambient"].Fail("must be in [0, " + std::to_string(static_cast<int>(kMaxSceneAmbient)) +
+                         "]");
+  }
   if (root.Has("bounce")) {
     const JsonNode b = root["bounce"];
     if (b.raw().is_boolean()) {
@@ -75,6 +134,7 @@ Scene LoadScene(const std::filesystem::path& path) {
     for (size_t i = 0; i < objects.Size(); ++i) {
       const JsonNode o = objects[i];
       const std::string type = o.GetString("type");
+      CheckExtents(o, {"min", "max", "origin", "u", "v"});
       if (type == "room") {
         o.CheckKeys({"type", "name", "min", "max", "floor", "ceiling", "walls"});
         const Eigen::Vector3d min = o.GetVec3("min"), max = o.GetVec3("max");
@@ -111,27 +171,7 @@ Scene LoadScene(const std::filesystem::path& path) {
     const JsonNode lights = root["lights"];
     if (lights.Size() > 8) lights.Fail("at most 8 lights");
     for (size_t i = 0; i < lights.Size(); ++i) {
-      const JsonNode l = lights[i];
-      l.CheckKeys({"name", "position", "look_at", "cone_deg", "power", "wavelength_nm", "size_m",
-                   "shadows"});
-      IrLight light;
-      light.name = l.GetString("name");
-      light.position = l.GetVec3("position");
-      const Eigen::Vector3d dir = l.GetVec3("look_at") - light.position;
-      if (dir.norm() < 1e-9) l["look_at"].Fail("must differ from 'position'");
-      light.direction = dir.normalized();
-      light.cone_deg = l.GetDouble("cone_deg", 60.0);
-      if (light.cone_deg <= 0 || light.cone_deg > 180) l["cone_deg"].Fail("must be in (0, 180]");
-      light.power = l.GetDouble("power", 1.0);
-      if (light.power < 0) l["power"].Fail("must be non-negative");
-      light.wavelength_nm = l.GetDouble("wavelength_nm", 850.0);
-      if (light.wavelength_nm != 850.0 && light.wavelength_nm != 940.0) {
-        l["wavelength_nm"].Fail("must be 850 or 940");
-      }
-      light.size_m = l.GetDouble("size_m", 0.0);
-      if (light.size_m < 0 || light.size_m > 5) l["size_m"].Fail("must be in [0, 5] m");
-      light.casts_shadows = l.GetBool("shadows", true);
-      scene.lights.push_back(light);
+      scene.lights.push_back(ReadLight(lights[i]));
     }
   }
   scene.mesh.Append(enclosure);

@@ -47,6 +47,18 @@ struct Scene {
   TriangleMesh mesh;  // all static geometry, screens included
 };
 
+// Physical ranges of a scene file's numbers (a file beyond them is refused
+// with InputError naming the file and field, instead of rendering black frames
+// from overflowed light). The presets use ambient 0.02..0.42, light power
+// 1.5..11 and rooms of 12 m; the bounds leave a wide margin.
+// Every coordinate, extent and direction component, metres: |x| <= this.
+inline constexpr double kMaxSceneCoordinateM = 1000.0;
+// `ambient`, relative radiance (1 lights an albedo-1 surface to white): [0, 10].
+inline constexpr double kMaxSceneAmbient = 10.0;
+// A light's `power`, relative on-axis radiant intensity: [0, 1000].
+inline constexpr double kMaxLightPower = 1000.0;
+
+// Loads and validates a scene (format and ranges in docs/formats.md and above).
 Scene LoadScene(const std::filesystem::path& path);
 
 }  // namespace irbench

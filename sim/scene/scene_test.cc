@@ -120,5 +120,44 @@ TEST(SceneMaterialTest, NamesPairsAndNumbers) {
   EXPECT_EQ(scene_error("off", R"({"format": "irbench.scene/1", "bounce": false, )" + quad + "}"), "no error");
 }
 
+// Issue 27.3: ambient 1e39 or a light power of 1e308 rendered all-black
+// frames with exit 0; every number has a physical range and an error naming
+// the field.
+TEST(SceneRangeTest, NumbersOutsidePhysicalRangesNameTheField) {
+  auto scene_error = [](const std::string& name, const std::string& body) {
+    try {
+      LoadScene(WriteScene(name, R"({"format": "irbench.scene/1", "bounce": false, )" + body + "}"));
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string("no error");
+  };
+  const std::string quad = R"("objects": [{"type": "quad", "origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0]}])";
+  auto light = [&](const std::string& fields) {
+    return quad + R"(, "lights": [{"name": "l", "position": [0, 0, 3], "look_at": [0, 0, 0], )" + fields + "}]";
+  };
+  EXPECT_EQ(scene_error("ambient", R"("ambient": 1e39, )" + quad), "ambient");
+  EXPECT_EQ(scene_error("ambient_high", R"("ambient": 10.5, )" + quad), "ambient");
+  EXPECT_EQ(scene_error("power", light(R"("power": 1e308)")), "lights[0].power");
+  EXPECT_EQ(scene_error("power_high", light(R"("power": 1001)")), "lights[0].power");
+  EXPECT_EQ(scene_error("light_far", quad + R"(, "lights": [{"name": "l", "position": [0, 0, 1e30], "look_at": [0, 0, 0]}])"),
+            "lights[0].position[2]");
+  EXPECT_EQ(scene_error("quad_far", R"("objects": [{"type": "quad", "origin": [0, 0, 0], "u": [1e39, 0, 0], "v": [0, 1, 0]}])"),
+            "objects[0].u[0]");
+  EXPECT_EQ(scene_error("room_far", R"("objects": [{"type": "room", "min": [-1e6, -5, 0], "max": [5, 5, 4]}])"),
+            "objects[0].min[0]");
+  EXPECT_EQ(scene_error("stage", R"("stage": {"center": [0, 0], "size": [3, 1e300]}, )" + quad), "stage.size[1]");
+  EXPECT_EQ(scene_error("screen", quad + R"(, "screens": [{"name": "s", "type": "cylinder", "center_xy": [0, 0],
+      "radius": 1e300, "angle_left_deg": 160, "angle_right_deg": 20, "z": [0, 2]}])"),
+            "screens[0].radius");
+  // At the bounds: fine.
+  EXPECT_EQ(scene_error("bounds", R"("ambient": 10, )" + light(R"("power": 1000)")), "no error");
+  // Every shipped scene is well inside them.
+  for (const Scene& scene : AllScenes()) {
+    EXPECT_LE(scene.ambient, 1.0) << scene.name;
+    for (const IrLight& l : scene.lights) EXPECT_LE(l.power, 100.0) << scene.name;
+  }
+}
+
 }  // namespace
 }  // namespace irbench

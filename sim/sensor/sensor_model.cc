@@ -115,6 +115,12 @@ void ApplyKnobs(const nlohmann::json& knobs, const std::string& file, const std:
                       : std::is_same_v<T, int> ? value.is_number_integer()
                                                : value.is_number();
       if (!ok) throw InputError(file, field + "." + key, "wrong type: " + value.dump());
+      // An integer beyond int would wrap into range (4294967304 -> 8).
+      if constexpr (std::is_same_v<T, int>) {
+        if (std::abs(value.template get<double>()) > 1e9) {
+          throw InputError(file, field + "." + key, "out of range: " + value.dump());
+        }
+      }
       member = value.template get<T>();
     });
     if (!known) throw InputError(file, field + "." + key, "unknown knob");

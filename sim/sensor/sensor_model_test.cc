@@ -190,5 +190,25 @@ TEST(SensorPresetTest, PresetsAndOverrides) {
   }
 }
 
+// Issue 27.3: an integer knob beyond int wrapped into range (4294967304 read
+// as 8 bits); every knob is range-checked, non-finite ones included.
+TEST(SensorPresetTest, OverridesOutsideTheirRangeNameTheKnob) {
+  auto field_of = [](const std::string& text) {
+    SensorSetup setup = *SensorPreset("thesis");
+    try {
+      ApplySensorOverrides(nlohmann::json::parse(text), "rig.json", "cameras[0].sensor", &setup);
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(field_of(R"({"sensor": {"bit_depth": 4294967304}})"), "cameras[0].sensor.sensor.bit_depth");
+  EXPECT_EQ(field_of(R"({"optics": {"motion_blur_samples": -4294967295}})"),
+            "cameras[0].sensor.optics.motion_blur_samples");
+  EXPECT_EQ(field_of(R"({"sensor": {"photons_per_ms": 1e308}})"), "cameras[0].sensor.sensor.photons_per_ms");
+  EXPECT_EQ(field_of(R"({"flicker": {"mains_hz": -1e-300}})"), "cameras[0].sensor.flicker.mains_hz");
+  EXPECT_EQ(field_of(R"({"sensor": {"bit_depth": 12}})"), "(no error)");
+}
+
 }  // namespace
 }  // namespace irbench
