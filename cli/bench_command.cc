@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 #include "cli/render_options.h"
 #include "common/error.h"
 #include "common/logging.h"
@@ -123,7 +124,8 @@ Command AddBenchRender(CLI::App* bench_cmd) {
                                 "resolution\n(320x240 and 640x480 for the shipped rigs)");
   AddRenderInputOptions(cmd, args->render, args->backend, args->shadows);
   cmd->add_option("--frames", args->frames, "timed frame-sets per resolution")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(IntegerIn(1, 100000));
   return {cmd, [args] { return RunBenchRender(*args); }};
 }
 
@@ -136,8 +138,10 @@ Command AddBenchTrack(CLI::App* bench_cmd) {
       "Milliseconds per frame-set of the tracker's stages, on a sequence rendered for it\n"
       "(images preloaded: decoding is not counted)");
   AddRenderInputOptions(cmd, args->render, args->backend, args->shadows);
-  cmd->add_option("--frames", args->frames, "frame-sets to render and time")->capture_default_str();
-  cmd->add_option("--repeats", args->repeats, "passes over them")->capture_default_str();
+  cmd->add_option("--frames", args->frames, "frame-sets to render and time")
+      ->capture_default_str()
+      ->transform(IntegerIn(1, 100000));
+  cmd->add_option("--repeats", args->repeats, "passes over them")->capture_default_str()->transform(IntegerIn(1, 1000));
   return {cmd, [args] { return RunBenchTrack(*args); }};
 }
 

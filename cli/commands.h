@@ -39,6 +39,8 @@ std::vector<Command> AddMotionCommand(CLI::App& app);
 std::vector<Command> AddAvatarCommand(CLI::App& app);
 // Adds `train rest`: the rest-state SVM.
 std::vector<Command> AddTrainCommand(CLI::App& app);
+// Adds `fault`: a copy of a sequence with camera faults put in.
+std::vector<Command> AddFaultCommand(CLI::App& app);
 // Adds `bench render|track`: throughput figures.
 std::vector<Command> AddBenchCommand(CLI::App& app);
 

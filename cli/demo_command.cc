@@ -6,6 +6,7 @@
 
 #include "ci/demo/demo_job.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 
 namespace irbench::cli {
 namespace {
@@ -20,6 +21,7 @@ struct DemoArgs {
 // Runs the demo; prints the tables and where each part went.
 int RunDemoCommand(const CLI::App& cmd, DemoArgs& args) {
   DemoOptions& demo = args.job;
+  RequireNotEmpty(cmd, "--out", args.out);
   demo.out = args.out;
   if (cmd.count("--frames") > 0) demo.frames = args.frames;
   const DemoResult r = RunDemo(demo);
@@ -47,9 +49,12 @@ std::vector<Command> AddDemoCommand(CLI::App& app) {
   cmd->add_option("--sensor", demo.sensor, "sensor preset: clean, thesis or harsh")
       ->capture_default_str();
   cmd->add_option("--frames", args->frames,
-                  "frames to render (default: the whole session; fewer for a quick look)");
-  cmd->add_option("--seed", demo.seed, "seed for everything random")->capture_default_str();
-  cmd->add_flag("--force", demo.overwrite, "replace an existing output folder");
+                  "frames to render (default: the whole session; fewer for a quick look)")
+      ->transform(IntegerIn(1, 1000000));
+  cmd->add_option("--seed", demo.seed, "seed for everything random")
+      ->capture_default_str()
+      ->transform(Uint64Text());
+  cmd->add_flag("--force", demo.overwrite, "replace an existing output folder (only one irbench wrote)");
   return {{cmd, [cmd, args] { return RunDemoCommand(*cmd, *args); }}};
 }
 

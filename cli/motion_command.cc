@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 #include "sim/sequence/motion_tools.h"
 
 namespace irbench::cli {
@@ -21,7 +22,9 @@ CLI::App* AddMotionExport(CLI::App* motion_cmd, MotionExportOptions& options) {
       ->capture_default_str();
   cmd->add_option("--scene", options.scene, "scene (for pointing targets)")->capture_default_str();
   cmd->add_option("--fps", options.fps, "frames per second")->capture_default_str();
-  cmd->add_option("--seed", options.seed, "seed of the person's style")->capture_default_str();
+  cmd->add_option("--seed", options.seed, "seed of the person's style")
+      ->capture_default_str()
+      ->transform(Uint64Text());
   cmd->add_option("OUT", options.out, "output .bvh file")->required();
   cmd->add_flag("--force", options.overwrite, "replace an existing file");
   return cmd;

@@ -1,5 +1,6 @@
 #include "cli/render_options.h"
 
+#include "cli/option_checks.h"
 #include "common/error.h"
 
 namespace irbench::cli {
@@ -21,7 +22,8 @@ void AddRenderInputOptions(CLI::App* cmd,
   cmd->add_option("--backend", backend, "OpenGL backend: auto, egl or osmesa")
       ->capture_default_str();
   cmd->add_option("--supersample", o.supersample, "pinhole pixels per output pixel per axis (1-4)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(IntegerIn(1, 4));
   cmd->add_option("--sensor", o.sensor, "sensor preset: clean, thesis or harsh")
       ->capture_default_str();
   cmd->add_option(

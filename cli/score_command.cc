@@ -7,6 +7,7 @@
 
 #include "ci/score/score_job.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 
 namespace irbench::cli {
 namespace {
@@ -19,8 +20,10 @@ struct ScoreArgs {
 };
 
 // Runs the score job; prints the tables, the report and the output folder.
-int RunScore(ScoreArgs& args) {
+int RunScore(const CLI::App& cmd, ScoreArgs& args) {
   ScoreJobOptions& score = args.job;
+  RequireNotEmpty(cmd, "--out", args.out);
+  RequireNotEmpty(cmd, "--track", args.track);
   score.sequence = args.sequence;
   score.track = args.track;
   score.out = args.out;
@@ -51,11 +54,12 @@ std::vector<Command> AddScoreCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "output folder (default: SEQ/score)");
   cmd->add_flag("--include-rest-arms", args->job.score.include_rest_arms,
                 "also score elbows and wrists of arms at rest (the thesis leaves them out)");
-  cmd->add_flag("--force", args->job.overwrite, "replace an existing output folder");
+  cmd->add_flag("--force", args->job.overwrite,
+                "replace an existing output folder (only one irbench wrote)");
   cmd->add_flag(
       "--no-report", args->no_report,
       "skip report.html (tables, gnuplot plots, frame viewer; opens offline in a browser)");
-  return {{cmd, [args] { return RunScore(*args); }}};
+  return {{cmd, [cmd, args] { return RunScore(*cmd, *args); }}};
 }
 
 }  // namespace irbench::cli

@@ -6,6 +6,7 @@
 
 #include "ci/suite_runner/suite.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 
 namespace irbench::cli {
 namespace {
@@ -17,8 +18,10 @@ struct SuiteArgs {
 };
 
 // Runs the suite; prints its table and reports; exit 1 when a metric failed.
-int RunSuiteCommand(SuiteArgs& args) {
+int RunSuiteCommand(const CLI::App& cmd, SuiteArgs& args) {
   SuiteRunOptions& suite = args.job;
+  RequireNotEmpty(cmd, "--baselines", args.baselines);
+  RequireNotEmpty(cmd, "--cache", args.cache);
   suite.suite = args.name;
   suite.baselines = args.baselines;
   suite.cache = args.cache;
@@ -53,8 +56,8 @@ std::vector<Command> AddSuiteCommand(CLI::App& app) {
   run->add_option("--baselines", args->baselines, "baseline folder (default: ci/baselines)");
   run->add_option("--cache", args->cache, "render cache folder (default: renders/cache)");
   run->add_option("--jobs", args->job.jobs, "scenarios at a time (default: the core count)")
-      ->check(CLI::PositiveNumber);
-  return {{run, [args] { return RunSuiteCommand(*args); }}};
+      ->transform(IntegerIn(1, 256));
+  return {{run, [run, args] { return RunSuiteCommand(*run, *args); }}};
 }
 
 }  // namespace irbench::cli

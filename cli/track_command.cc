@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 #include "common/error.h"
 #include "tracker/pipeline/track_job.h"
 
@@ -50,6 +51,7 @@ void AddTrackerSettingOptions(CLI::App* cmd, TrackArgs& args) {
 int RunTrack(const CLI::App& cmd, TrackArgs& args) {
   TrackJobOptions& track = args.job;
   track.sequence = args.sequence;
+  RequireNotEmpty(cmd, "--out", args.out);
   track.out = args.out;
   for (const auto& [setting, text] : args.typed) SetFromText(*setting, text, track.tracker);
   if (cmd.count("--frames") > 0) track.frames = args.frames;
@@ -69,9 +71,11 @@ std::vector<Command> AddTrackCommand(CLI::App& app) {
   cmd->add_flag("--overlays", args->job.overlays, "also write debug overlays (PNG, colour)");
   cmd->add_flag("--ply", args->job.ply,
                 "also write the voxel and polyhedral hulls per frame as PLY");
-  cmd->add_option("--frames", args->frames, "frames to process (default: all)");
+  cmd->add_option("--frames", args->frames, "frames to process (default: all)")
+      ->transform(IntegerIn(1, 1000000));
   cmd->add_option("--out", args->out, "output folder (default: SEQ/track)");
-  cmd->add_flag("--force", args->job.overwrite, "replace an existing output folder");
+  cmd->add_flag("--force", args->job.overwrite,
+                "replace an existing output folder (only one irbench wrote)");
   return {{cmd, [cmd, args] { return RunTrack(*cmd, *args); }}};
 }
 

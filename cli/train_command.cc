@@ -6,6 +6,7 @@
 
 #include "ci/train/rest_training.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 
 namespace irbench::cli {
 namespace {
@@ -17,8 +18,9 @@ struct TrainRestArgs {
 };
 
 // Trains the rest-state SVM; prints its cross-validated accuracy and the model file.
-int RunTrainRest(TrainRestArgs& args) {
+int RunTrainRest(const CLI::App& cmd, TrainRestArgs& args) {
   RestTrainingOptions& train_rest = args.job;
+  RequireNotEmpty(cmd, "--out", args.out);
   train_rest.out = args.out;
   const RestTrainingResult r = RunRestTraining(train_rest);
   std::cout << "rest-state SVM: " << r.samples << " arm samples (" << r.at_rest << " at rest), "
@@ -45,10 +47,14 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--fps", train_rest.sample_fps, "samples per second of motion")
       ->capture_default_str();
-  cmd->add_option("--folds", train_rest.folds, "cross-validation folds")->capture_default_str();
-  cmd->add_option("--seed", train_rest.seed, "seed of the motions' styles")->capture_default_str();
+  cmd->add_option("--folds", train_rest.folds, "cross-validation folds")
+      ->capture_default_str()
+      ->transform(IntegerIn(2, 100));
+  cmd->add_option("--seed", train_rest.seed, "seed of the motions' styles")
+      ->capture_default_str()
+      ->transform(Uint64Text());
   cmd->add_option("--out", args->out, "model file (default: tracker/models/rest_svm.yml)");
-  return {{cmd, [args] { return RunTrainRest(*args); }}};
+  return {{cmd, [cmd, args] { return RunTrainRest(*cmd, *args); }}};
 }
 
 }  // namespace irbench::cli

@@ -361,15 +361,29 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
   }
   for (const char* name : {"t2", "t3", "t4", "t5", "t6", "t7", "t8"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
-  // An output that would replace the sequence or land in what it reads.
-  for (const auto& [out, expected] : {std::pair<fs::path, std::string>{dir / "seq", "would replace the sequence"},
-                                      {dir, "would replace the sequence"},
-                                      {dir / "seq" / "frames" / "x", "inside the sequence's frames/"}}) {
+  // An output that would replace the sequence or land in what it reads
+  // (common/atomic_file.h), or a folder irbench did not write.
+  fs::create_directories(dir / "mine");
+  WriteText(dir / "mine" / "notes.txt", "keep");
+  for (const auto& [out, expected] :
+       {std::pair<fs::path, std::string>{dir / "seq", "contains the input"},
+        {dir, "contains the input"},
+        {dir / "seq" / "frames" / "x", "lies inside the input"},
+        {dir / "seq" / "calib", "is an input of this command"},
+        {dir / "mine", "was not written by irbench"}}) {
     const Result bad = RunIrbench({"track", (dir / "seq").string(), "--out", out.string(), "--force"}, dir);
     EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_NE(bad.err.find("--out"), std::string::npos) << bad.err;
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
   EXPECT_TRUE(fs::exists(dir / "seq" / "manifest.json"));
+  EXPECT_EQ(ReadText(dir / "mine" / "notes.txt"), "keep");
+  // The default output, SEQ/track, lies in the sequence but in nothing it
+  // reads: replaced with --force, marked as irbench's.
+  ASSERT_EQ(RunIrbench({"track", (dir / "seq").string(), "--stage", "features", "--overlays", "--force"}, dir)
+                .exit_code,
+            0);
+  EXPECT_NE(ReadText(track / ".irbench-output").find("\"command\":\"track\""), std::string::npos);
 
   // An empty stage (the empty-stage frames given as the frames): state "empty",
   // the root null.
@@ -437,6 +451,47 @@ TEST(CliTest, ScorePrintsTheTablesAndRefusesBadInput) {
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
   EXPECT_FALSE(fs::exists(dir / "s2"));
+
+  // --force never deletes what the score reads or what irbench did not write:
+  // the sequence, its truth, the track's folder, the sequence's parent.
+  fs::create_directories(dir / "seq" / "track");
+  WriteText(dir / "seq" / "track" / "track.jsonl", track);
+  WriteText(dir / "mine.txt", "keep");
+  const std::string truth_before = ReadText(dir / "seq/truth/frames.jsonl");
+  for (const auto& [out, expected] :
+       {std::pair<fs::path, std::string>{dir / "seq", "contains the input"},
+        {dir / "seq" / "truth", "is an input of this command"},
+        {dir / "seq" / "track", "contains the input"},
+        {dir, "contains the input"},
+        {dir / "mine.txt", "was not written by irbench"}}) {
+    const Result bad = RunIrbench({"score", (dir / "seq").string(), "--out", out.string(), "--force"}, dir);
+    EXPECT_EQ(bad.exit_code, 2) << out << ": " << bad.err;
+    EXPECT_NE(bad.err.find("--out"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find(expected), std::string::npos) << out << ": " << bad.err;
+  }
+  EXPECT_EQ(ReadText(dir / "seq/truth/frames.jsonl"), truth_before);
+  EXPECT_TRUE(fs::exists(dir / "seq/manifest.json"));
+  EXPECT_TRUE(fs::exists(dir / "seq/track/track.jsonl"));
+  EXPECT_EQ(ReadText(dir / "mine.txt"), "keep");
+  // Its own output is replaced with --force.
+  EXPECT_EQ(RunIrbench({"score", (dir / "seq").string(), "--force", "--no-report"}, dir).exit_code, 0);
+
+  // A truth without frames is refused; one covering fewer frames than the
+  // manifest and the track is scored with warnings.
+  fs::create_directories(dir / "short" / "truth");
+  fs::copy_file(dir / "seq/manifest.json", dir / "short/manifest.json");
+  WriteText(dir / "short/truth/frames.jsonl", "");
+  const Result empty = RunIrbench(
+      {"score", (dir / "short").string(), "--track", (dir / "track.jsonl").string(), "--no-report"}, dir);
+  EXPECT_EQ(empty.exit_code, 2) << empty.out << empty.err;
+  EXPECT_NE(empty.err.find("truth/frames.jsonl"), std::string::npos) << empty.err;
+  EXPECT_FALSE(fs::exists(dir / "short" / "score"));
+  WriteText(dir / "short/truth/frames.jsonl", truth_before.substr(0, truth_before.find('\n') + 1));
+  const Result partial = RunIrbench(
+      {"score", (dir / "short").string(), "--track", (dir / "track.jsonl").string(), "--no-report"}, dir);
+  EXPECT_EQ(partial.exit_code, 0) << partial.err;
+  EXPECT_NE(partial.err.find("holds 1 of the 6 frames the manifest lists"), std::string::npos) << partial.err;
+  EXPECT_NE(partial.err.find("has frames up to 5"), std::string::npos) << partial.err;
 }
 
 TEST(CliTest, DemoRendersTracksAndScores) {
@@ -557,6 +612,160 @@ TEST(CliTest, RenderWritesTheSequenceAndPrintsWhere) {
   EXPECT_EQ(RunIrbench({"render", "--frames", "1", "--out", (dir / "seq").string()}, dir).exit_code, 2);
   EXPECT_EQ(RunIrbench({"render", "--frames", "1", "--out", (dir / "seq").string(), "--force"}, dir).exit_code, 0);
   EXPECT_FALSE(fs::exists(dir / "seq/frames/front_left/000002.png"));
+  EXPECT_NE(ReadText(dir / "seq" / ".irbench-output").find("\"command\":\"render\""), std::string::npos);
+  // --force replaces only a folder irbench wrote, and never one holding an input.
+  fs::create_directories(dir / "input-mine");
+  WriteText(dir / "input-mine" / "notes.txt", "keep");
+  fs::copy_file(fs::path(IRBENCH_SOURCE_DIR) / "rigs" / "lab4.json", dir / "seq" / "rig.json");
+  for (const auto& [args, expected] :
+       {std::pair<std::vector<std::string>, std::string>{{"--out", (dir / "input-mine").string()},
+                                                        "was not written by irbench"},
+        {{"--rig", (dir / "seq" / "rig.json").string(), "--out", (dir / "seq").string()}, "contains the input"},
+        {{"--rig", (dir / "seq" / "rig.json").string(), "--out", (dir / "seq" / "rig.json").string()},
+         "is an input of this command"}}) {
+    std::vector<std::string> all = {"render", "--frames", "1", "--force"};
+    all.insert(all.end(), args.begin(), args.end());
+    const Result bad = RunIrbench(all, dir);
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_NE(bad.err.find("--out"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
+  }
+  EXPECT_EQ(ReadText(dir / "input-mine" / "notes.txt"), "keep");
+  EXPECT_TRUE(fs::exists(dir / "seq" / "rig.json"));
+  EXPECT_EQ(Leftovers(dir), std::vector<std::string>{"seq"});
+}
+
+// Numbers out of range are refused, never clamped or wrapped, and an empty
+// path never means "the default": one line naming the option, exit 2,
+// nothing written.
+TEST(CliTest, OutOfRangeNumbersAndEmptyPathsAreRefused) {
+  const fs::path dir = FreshTempDir("cli_numbers");
+  const std::string out = (dir / "out").string(), seq = (dir / "seq").string();
+  for (const auto& [args, option] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"render", "--frames", "1", "--seed", "18446744073709551616", "--out", out}, "--seed"},
+           {{"render", "--frames", "1", "--seed", "-1", "--out", out}, "--seed"},
+           {{"render", "--frames", "1", "--seed", "0x10", "--out", out}, "--seed"},
+           {{"render", "--frames", "0", "--out", out}, "--frames"},
+           {{"render", "--frames", "-3", "--out", out}, "--frames"},
+           {{"render", "--frames", "4294967297", "--out", out}, "--frames"},
+           {{"render", "--frames", "1", "--background-frames", "-1", "--out", out}, "--background-frames"},
+           {{"render", "--frames", "1", "--supersample", "9", "--out", out}, "--supersample"},
+           {{"render", "--frames", "1", "--out", ""}, "--out"},
+           {{"demo", "--seed", "-1", "--out", out}, "--seed"},
+           {{"demo", "--frames", "0", "--out", out}, "--frames"},
+           {{"demo", "--frames", "1", "--out", ""}, "--out"},
+           {{"track", seq, "--frames", "0"}, "--frames"},
+           {{"track", seq, "--out", ""}, "--out"},
+           {{"track", seq, "--particles", "1000000", "--out", out}, "--particles"},
+           {{"track", seq, "--particles", "50000", "--out", out}, "--particles"},
+           {{"score", seq, "--out", ""}, "--out"},
+           {{"suite", "run", "smoke", "--jobs", "0", "--cache", out}, "--jobs"},
+           {{"suite", "run", "smoke", "--cache", ""}, "--cache"},
+           {{"motion", "export", "--motion", "wave", "--seed", "-1", (dir / "m.bvh").string()}, "--seed"},
+           {{"train", "rest", "--folds", "1", "--out", out}, "--folds"},
+           {{"train", "rest", "--out", ""}, "--out"}}) {
+    const Result bad = RunIrbench(args, dir);
+    EXPECT_EQ(bad.exit_code, 2) << args[0] << " " << option << ": " << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+    EXPECT_NE(bad.err.find(option), std::string::npos) << bad.err;
+    EXPECT_TRUE(Leftovers(dir).empty()) << args[0] << " " << option;
+  }
+  // The largest seed is a seed.
+  const Result big = RunIrbench({"motion", "export", "--motion", "wave", "--seed", "18446744073709551615",
+                                 (dir / "m.bvh").string()},
+                                dir);
+  EXPECT_EQ(big.exit_code, 0) << big.err;
+}
+
+// Every file under `root` by its path relative to it, with its bytes.
+std::map<std::string, std::string> FilesUnder(const fs::path& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(root)) {
+    if (e.is_regular_file()) files[fs::relative(e.path(), root).string()] = ReadText(e.path());
+  }
+  return files;
+}
+
+// The staging folders ".<name>.partial-<pid>" in `dir`.
+std::vector<std::string> PartialFolders(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.find(".partial-") != std::string::npos) names.push_back(name);
+  }
+  return names;
+}
+
+// A render killed outright (SIGKILL) leaves its staging folder; `render
+// --resume` carries on from the frames its journal lists — cut back here to 7
+// frames with a torn 8th line, the last kept frame one the front_left camera
+// dropped (it repeats an earlier image, state the resumed run must restore) —
+// and ends byte-identical to an uninterrupted render. A staging folder of
+// other options is started over.
+TEST(CliTest, KilledRenderResumesToTheSameBytes) {
+  const fs::path dir = FreshTempDir("cli_resume");
+  auto rig = nlohmann::json::parse(ReadText(std::string(IRBENCH_SOURCE_DIR) + "/rigs/lab4.json"));
+  rig["cameras"][0]["sensor"] = {{"capture", {{"drop_rate", 0.5}}}};
+  rig["cameras"][1]["sensor"] = {{"optics", {{"motion_blur_samples", 3}}}};
+  rig["cameras"][2]["sensor"] = {{"capture", {{"sync_jitter_ms", 20.0}}}};
+  WriteText(dir / "input-rig.json", rig.dump());
+  const std::string first_camera = rig["cameras"][0]["name"];
+  std::vector<std::string> args = {"render", "--rig", (dir / "input-rig.json").string(), "--frames", "12",
+                                   "--background-frames", "3", "--sensor", "thesis", "--supersample", "1"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> all = args;
+    all.insert(all.end(), extra.begin(), extra.end());
+    return all;
+  };
+  ASSERT_EQ(RunIrbench(with({"--out", (dir / "ref").string()}), dir).exit_code, 0);
+  // The render to kill, once its staging folder holds frame 8.
+  std::vector<std::string> argv_strings = with({"--out", (dir / "seq").string()});
+  argv_strings.insert(argv_strings.begin(), kIrbench);
+  std::vector<char*> argv;
+  for (std::string& a : argv_strings) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    freopen((dir / "stderr.txt").c_str(), "w", stderr);
+    execv(kIrbench.c_str(), argv.data());
+    _exit(127);
+  }
+  const fs::path partial = dir / (".seq.partial-" + std::to_string(pid));
+  for (int i = 0; i < 60000 && !fs::exists(partial / "frames" / first_camera / "000008.png"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the render ended before it was killed";
+  ASSERT_TRUE(fs::is_directory(partial));
+  EXPECT_FALSE(fs::exists(dir / "seq"));
+  fs::copy(partial, dir / (".other.partial-" + std::to_string(pid)), fs::copy_options::recursive);
+  // Keep 7 frames and a torn line, as if killed while appending the 8th.
+  const std::string journal = ReadText(partial / ".render-journal/frames.jsonl");
+  size_t cut = 0;
+  for (int line = 0; line < 7; ++line) cut = journal.find('\n', cut) + 1;
+  WriteText(partial / ".render-journal/frames.jsonl", journal.substr(0, cut + 40));
+  std::ifstream ref_truth(dir / "ref/truth/frames.jsonl");
+  std::string line;
+  for (int f = 0; f <= 6; ++f) std::getline(ref_truth, line);
+  EXPECT_TRUE(nlohmann::json::parse(line)["sensor"][first_camera]["dropped"].get<bool>())
+      << "frame 6 is meant to be a dropped one";
+
+  const Result resumed = RunIrbench(with({"--out", (dir / "seq").string(), "--resume"}), dir);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("resuming after 3 of 3 empty-stage frames and 7 of 12 frames"), std::string::npos)
+      << resumed.err;
+  EXPECT_EQ(FilesUnder(dir / "seq"), FilesUnder(dir / "ref"));
+  EXPECT_EQ(PartialFolders(dir), std::vector<std::string>{".other.partial-" + std::to_string(pid)});
+
+  // Other options (seed 2): the kept frames are not used.
+  const Result other = RunIrbench(with({"--seed", "2", "--out", (dir / "other").string(), "--resume"}), dir);
+  ASSERT_EQ(other.exit_code, 0) << other.err;
+  EXPECT_NE(other.err.find("made with other options"), std::string::npos) << other.err;
+  EXPECT_EQ(nlohmann::json::parse(ReadText(dir / "other/manifest.json"))["seed"], 2);
+  EXPECT_TRUE(PartialFolders(dir).empty());
 }
 
 TEST(CliTest, InterruptLeavesNoHalfWrittenFile) {

@@ -4,15 +4,18 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <random>
 #include <opencv2/imgproc.hpp>
 #include <unistd.h>
 
+#include "common/cancel.h"
 #include "common/error.h"
 #include "sim/camera/rig.h"
 #include "tracker/pose/icp.h"
+#include "tracker/pose/particle_filter.h"
 #include "tracker/pose/observation.h"
 #include "tracker/pose/pointing.h"
 #include "tracker/pose/pose_tracker.h"
@@ -325,6 +328,26 @@ TEST(PoseTracker, FollowsAModelRaisingItsArmAndRecoversFromScattering) {
   FrameFeatures empty = ModelFeatures(cams, shape, truth, 40);
   empty.placement.reset();
   EXPECT_FALSE(tracker.Step(empty, 1.0 / 30).tracking);
+}
+
+// Ctrl-C is honoured within a frame's particles (issue 27): a cancel that
+// arrives while the particles are scored stops the scoring and throws
+// Cancelled in the caller, instead of finishing the whole frame.
+TEST(ParticleFilter, ACancelStopsTheScoringWithinTheFrame) {
+  ResetCancel();
+  const std::vector<BodyPose> particles(2000);
+  std::atomic<int> scored{0};
+  const PoseScore score = [&](const BodyPose&) {
+    if (++scored == 10) RequestCancel();
+    return 0.0;
+  };
+  EXPECT_THROW(WeighParticles(particles, score), Cancelled);
+  // Each worker stops at its next particle: far fewer than all were scored.
+  EXPECT_LT(scored.load(), 200);
+  ResetCancel();
+  scored = 0;
+  EXPECT_EQ(WeighParticles(particles, [&](const BodyPose&) { return 1.0 * ++scored; }).size(), particles.size());
+  EXPECT_EQ(scored.load(), 2000);
 }
 
 TEST(Pointing, RayFromHeadThroughHandTipHitsTheNearestScreen) {

@@ -1,5 +1,6 @@
 #include "ci/score/score_job.h"
 
+#include <fstream>
 #include <sstream>
 
 #include "ci/report/report.h"
@@ -20,6 +21,38 @@ std::string Csv(int total, double v) {
   return out.str();
 }
 
+// The files and folders a score reads: the sequence's truth/, calib/,
+// frames/ (the report's viewer), manifest.json, the track file and the
+// silhouettes beside it.
+std::vector<fs::path> ScoreInputs(const ScoreJobOptions& options, const fs::path& track) {
+  std::vector<fs::path> inputs;
+  for (const char* part : {"truth", "calib", "frames", "manifest.json"}) inputs.push_back(options.sequence / part);
+  inputs.push_back(track);
+  if (fs::is_directory(track.parent_path() / "silhouettes")) inputs.push_back(track.parent_path() / "silhouettes");
+  return inputs;
+}
+
+// Refuses a truth without frames (an interrupted or truncated render);
+// warns when it covers fewer frames than the manifest says or the track has.
+void CheckTruthCoverage(const ScoreJobOptions& options, const fs::path& truth, const fs::path& track,
+                        const Score& score) {
+  if (score.truth_frames == 0) {
+    throw InputError(truth.string(), "", "no frames: nothing to score against (an interrupted or truncated render?)");
+  }
+  std::ifstream manifest_file(options.sequence / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_file, nullptr, false);
+  if (!manifest.is_discarded() && manifest.is_object() && manifest.contains("frame_count") &&
+      manifest["frame_count"].is_number_integer() && manifest["frame_count"].get<int>() > score.truth_frames) {
+    Log().warn("score: {} holds {} of the {} frames the manifest lists; the rest are not scored", truth.string(),
+               score.truth_frames, manifest["frame_count"].get<int>());
+  }
+  const std::map<int, nlohmann::json> track_lines = ReadFrameLines(track);
+  if (!track_lines.empty() && track_lines.rbegin()->first >= score.truth_frames) {
+    Log().warn("score: {} has frames up to {}, past the {} of {}: those are not scored", track.string(),
+               track_lines.rbegin()->first, score.truth_frames, truth.string());
+  }
+}
+
 }  // namespace
 
 fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score* score_out) {
@@ -30,7 +63,11 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score
   if (!fs::is_regular_file(track)) {
     throw InputError(track.string(), "--track", "no such track file (irbench track writes one; or give --track)");
   }
+  const fs::path out = options.out.empty() ? options.sequence / "score" : options.out;
+  CheckOutputApart(out, ScoreInputs(options, track), "--out");
+  CheckOutputReplaceable(out, options.overwrite, "--out");
   Score score = ScoreTrack(truth, track, options.score);
+  CheckTruthCoverage(options, truth, track, score);
   // The silhouettes irbench track writes beside its track file, against the
   // truth masks.
   const fs::path silhouettes = track.parent_path() / "silhouettes";
@@ -43,8 +80,7 @@ fs::path RunScoreJob(const ScoreJobOptions& options, std::string* summary, Score
                  silhouettes.string());
     }
   }
-  const fs::path out = options.out.empty() ? options.sequence / "score" : options.out;
-  StagingDir staging(out, options.overwrite, "--out");
+  StagingDir staging(out, options.overwrite, "--out", "score");
   nlohmann::json j = score.ToJson();
   j["truth"] = fs::absolute(truth).lexically_normal().string();
   j["track"] = fs::absolute(track).lexically_normal().string();

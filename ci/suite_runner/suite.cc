@@ -130,6 +130,12 @@ std::string Number(double v) {
   return buf;
 }
 
+// The files a scenario's render reads (validated, names resolved).
+std::vector<fs::path> ScenarioInputFiles(const RenderJobOptions& r) {
+  const RenderInputs in = LoadRenderInputs(r);
+  return {in.rig_file, in.scene_file, in.avatar_file, in.motion_file};
+}
+
 // The render inputs that decide the frames, hashed with the tool version and
 // the contents of the files they name.
 std::string CacheKey(const RenderJobOptions& r) {
@@ -236,6 +242,13 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   nlohmann::json baseline = nlohmann::json::object();
   if (fs::is_regular_file(baseline_file)) baseline = ParseJsonFile(baseline_file.string()).raw();
   const fs::path cache = options.cache.empty() ? DataRoot() / "renders" / "cache" : options.cache;
+  // The cache holds what the suite writes; it may not hold or lie in what it
+  // reads (the suite file, the baselines, the scenarios' data files).
+  std::vector<fs::path> inputs = {file, baselines_dir};
+  for (const Scenario& sc : scenarios) {
+    for (const fs::path& f : ScenarioInputFiles(sc.render)) inputs.push_back(f);
+  }
+  CheckOutputApart(cache, inputs, "--cache");
   fs::create_directories(cache);
   // Scenarios in parallel, up to --jobs workers (default: the core count).
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());

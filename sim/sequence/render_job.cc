@@ -16,17 +16,12 @@
 #include "sim/motion/bvh.h"
 #include "sim/sensor/exposure.h"
 #include "sim/sequence/image_io.h"
+#include "sim/sequence/render_resume.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string FrameName(int frame, const char* ext) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%06d.%s", frame, ext);
-  return buffer;
-}
 
 double TruthTolerance(const Avatar& avatar, const std::string& joint_name) {
   // "left_elbow" -> "elbow"; a point is seen when the surface at its pixel lies
@@ -150,9 +145,20 @@ FrameTruth ComputeFrameTruth(const RenderInputs& inputs,
 
 namespace {
 
+// The files a render reads: scene, rig, avatar (and its mesh), motion.
+std::vector<fs::path> RenderInputFiles(const RenderInputs& in) {
+  std::vector<fs::path> files = {in.scene_file, in.rig_file, in.avatar_file, in.motion_file};
+  const nlohmann::json& source = in.avatar.params.source;
+  if (source.is_object() && source.contains("file") && source["file"].is_string()) {
+    files.push_back(source["file"].get<std::string>());
+  }
+  return files;
+}
+
 // The sequence folder to write: --out, or renders/<rig>-<avatar>-<motion>-s<seed>.
-// Throws InputError when its parent folder is missing, or when it exists and
-// --force was not given; checked before the slow GL start.
+// Throws InputError when its parent folder is missing, when it exists and
+// --force was not given or irbench did not write it, or when it holds or lies
+// in an input file; checked before the slow GL start.
 fs::path OutputFolder(const RenderJobOptions& options, const RenderInputs& in) {
   fs::path out = options.out;
   if (out.empty()) {
@@ -160,13 +166,8 @@ fs::path OutputFolder(const RenderJobOptions& options, const RenderInputs& in) {
           (in.rig.name + "-" + in.avatar.params.name + "-" + in.motion_name + "-s" +
            std::to_string(options.seed));
   }
-  if (!fs::is_directory(fs::absolute(out).parent_path())) {
-    throw InputError("", "--out", "parent folder '" + fs::absolute(out).parent_path().string() +
-                                      "' does not exist");
-  }
-  if (fs::exists(out) && !options.overwrite) {
-    throw InputError("", "--out", "'" + out.string() + "' exists (pass --force to replace it)");
-  }
+  CheckOutputApart(out, RenderInputFiles(in), "--out");
+  CheckOutputReplaceable(out, options.overwrite, "--out");
   return out;
 }
 
@@ -343,15 +344,53 @@ CleanRender CleanRenderOf(const CameraImages& images) {
   return {images.grey, images.radiance, images.depth};
 }
 
+// The rig's camera names, in order.
+std::vector<std::string> CameraNames(const RenderInputs& in) {
+  std::vector<std::string> names;
+  for (const Camera& cam : in.rig.cameras) names.push_back(cam.name);
+  return names;
+}
+
+// Where a frame loop starts: the first frame-set to render, and those before
+// `kept` (rendered again only to restore the cameras' state) checked against
+// the kept files and `kept_lines` instead of written (render_resume.h).
+struct ResumeFrom {
+  const std::vector<std::string>& kept_lines;
+  int kept = 0;
+  int first = 0;
+};
+
+ResumeFrom ResumeFromKept(const std::vector<std::string>& kept_lines, const RenderInputs& in) {
+  return {kept_lines, static_cast<int>(kept_lines.size()), ReplayStart(kept_lines, CameraNames(in))};
+}
+
+// Frame-set f's truth line `line`: appended to `lines` and the journal, or,
+// rendered again, checked against the kept one.
+void KeepTruthLine(RenderRun& run, const char* kind, const ResumeFrom& from, int f, const std::string& line,
+                   std::string& lines) {
+  if (f < from.kept) {
+    if (line != from.kept_lines[f]) throw ResumeMismatch(std::string(kind) + " truth line " + std::to_string(f) + " differs");
+    return;
+  }
+  lines += line;
+  AppendToJournal(run.root, kind, line);
+}
+
 // Renders and writes the empty-stage frames (background/<cam>/), at the
 // camera rate before t = 0 (`background_s` s of them), with the screens'
 // calibration sweep when `sweep_screens`; returns truth/background.jsonl.
-std::string RenderBackground(RenderRun& run, bool sweep_screens, double background_s) {
+// Resumed, carries on after the `kept` frame-sets.
+std::string RenderBackground(RenderRun& run,
+                             bool sweep_screens,
+                             double background_s,
+                             const std::vector<std::string>& kept) {
   const RenderInputs& in = run.in;
   const int count = run.options.background_frames;
   std::string background_lines;
+  for (const std::string& line : kept) background_lines += line;
+  const ResumeFrom from = ResumeFromKept(kept, in);
   run.renderer.SetPersonVisible(false);
-  for (int f = 0; f < count; ++f) {
+  for (int f = from.kept < count ? from.first : count; f < count; ++f) {
     ThrowIfCancelled();
     run.renderer.RenderAll(&run.all_images, run.need_depth);
     const double t = f / in.fps - background_s;
@@ -360,9 +399,11 @@ std::string RenderBackground(RenderRun& run, bool sweep_screens, double backgrou
     for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
       const cv::Mat frame = run.exposure.Expose(c, CleanRenderOf(run.all_images[c]), cv::Mat(), 1, t,
                                                 (1ull << 40) + f, sensor_truth, sweep);
-      WritePngAtomic(run.root / "background" / in.rig.cameras[c].name / FrameName(f, "png"), frame);
+      WriteOrVerify(run.root / "background" / in.rig.cameras[c].name / FrameFileName(f, "png"), EncodePng(frame),
+                    f < from.kept);
     }
-    background_lines += nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";
+    const std::string line = nlohmann::json{{"frame", f}, {"t", t}, {"sensor", sensor_truth}}.dump() + "\n";
+    KeepTruthLine(run, "background", from, f, line, background_lines);
     run.progress.FrameSetDone("background", f, count);
   }
   return background_lines;
@@ -431,14 +472,16 @@ void RenderFrameSet(RenderRun& run,
 }
 
 // Exposes frame f (time t, s) of every camera from run.all_images and writes
-// it, its mask and (with --depth) its depth; returns the sensor truth per
+// it, its mask and (with --depth) its depth, or with `verify` checks the
+// frame and mask against the files there; returns the sensor truth per
 // camera, with each camera's sync offset (ms).
 nlohmann::json ExposeAndWriteFrameSet(RenderRun& run,
                                       const MotionBlurPlan& blur,
                                       int f,
                                       double t,
                                       const std::vector<double>& instant,
-                                      const std::vector<cv::Mat>& radiance_sums) {
+                                      const std::vector<cv::Mat>& radiance_sums,
+                                      bool verify) {
   const RenderInputs& in = run.in;
   const fs::path& root = run.root;
   nlohmann::json sensor_truth = nlohmann::json::object();
@@ -447,10 +490,11 @@ nlohmann::json ExposeAndWriteFrameSet(RenderRun& run,
     const cv::Mat frame = run.exposure.Expose(c, CleanRenderOf(run.all_images[c]), radiance_sums[c], blur.samples,
                                               instant[c], f, sensor_truth);
     sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
-    WritePngAtomic(root / "frames" / cam_name / FrameName(f, "png"), frame);
-    WritePngAtomic(root / "truth" / "masks" / cam_name / FrameName(f, "png"), run.all_images[c].mask);
-    if (run.options.write_depth) {
-      WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameName(f, "exr"),
+    WriteOrVerify(root / "frames" / cam_name / FrameFileName(f, "png"), EncodePng(frame), verify);
+    WriteOrVerify(root / "truth" / "masks" / cam_name / FrameFileName(f, "png"), EncodePng(run.all_images[c].mask),
+                  verify);
+    if (run.options.write_depth && !verify) {
+      WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameFileName(f, "exr"),
                           run.all_images[c].depth);
     }
   }
@@ -497,14 +541,17 @@ nlohmann::json TruthLine(const RenderInputs& in,
 // truth/depth/). With motion blur, sub-frames over the exposure are rendered
 // and averaged; the last render is always at the frame time, so masks, depth
 // and visibility belong to the truth's instant. Returns truth/frames.jsonl.
-std::string RenderSequence(RenderRun& run, const MotionBlurPlan& blur) {
+// Resumed, carries on after the `kept` frame-sets.
+std::string RenderSequence(RenderRun& run, const MotionBlurPlan& blur, const std::vector<std::string>& kept) {
   const RenderInputs& in = run.in;
   run.renderer.SetPersonVisible(true);
   std::vector<MeshVertex> skinned;
   std::string truth_lines;
+  for (const std::string& line : kept) truth_lines += line;
+  const ResumeFrom from = ResumeFromKept(kept, in);
   const Labeler labeler(in.avatar, &in.scene, *in.motion);
   std::vector<cv::Mat> radiance_sums(in.rig.cameras.size());
-  for (int f = 0; f < in.frame_count; ++f) {
+  for (int f = from.kept < in.frame_count ? from.first : in.frame_count; f < in.frame_count; ++f) {
     ThrowIfCancelled();
     const double t = f / in.fps;
     bool jittered = false;
@@ -512,9 +559,11 @@ std::string RenderSequence(RenderRun& run, const MotionBlurPlan& blur) {
     RenderFrameSet(run, blur, t, instant, jittered, skinned, radiance_sums);
     const JointTransforms world_from_joint =
         ForwardKinematics(in.avatar.skeleton, in.motion->At(t));
-    const nlohmann::json sensor_truth = ExposeAndWriteFrameSet(run, blur, f, t, instant, radiance_sums);
+    const nlohmann::json sensor_truth =
+        ExposeAndWriteFrameSet(run, blur, f, t, instant, radiance_sums, f < from.kept);
     const FrameTruth truth = ComputeFrameTruth(in, world_from_joint, run.renderer);
-    truth_lines += TruthLine(in, labeler, f, t, truth, sensor_truth).dump() + "\n";
+    KeepTruthLine(run, "frames", from, f, TruthLine(in, labeler, f, t, truth, sensor_truth).dump() + "\n",
+                  truth_lines);
     run.progress.FrameSetDone("frame", f, in.frame_count);
   }
   return truth_lines;
@@ -539,6 +588,44 @@ void WriteMotionTruth(const fs::path& root, const RenderInputs& in) {
 
 }  // namespace
 
+namespace {
+
+// The job's parts once GL is up: the inputs, the renderer and the staging
+// folder's root.
+struct RenderSetup {
+  const RenderJobOptions& options;
+  const RenderInputs& in;
+  Renderer& renderer;
+  fs::path root;
+  bool sweep_screens = false;
+};
+
+// Creates the folders, writes the calibration, renders the empty-stage frames
+// and the sequence after what `kept` holds, and writes the truth files.
+void RenderFrameSets(const RenderSetup& setup, const RenderJournal& kept) {
+  const RenderJobOptions& options = setup.options;
+  const RenderInputs& in = setup.in;
+  CreateSequenceFolders(setup.root, in, options.write_depth);
+  WriteSequenceCalibration(setup.root, in);
+  RenderProgress progress;
+  // The sensor model per camera; background frames come before t = 0.
+  const double background_s = options.background_frames / in.fps;
+  RigExposure exposure(in.rig.cameras, in.rig.timing, in.sensors, in.sensor_active, options.seed, -background_s,
+                       in.frame_count / in.fps);
+  const MotionBlurPlan blur = PlanMotionBlur(in);
+  RenderRun run{options, in, setup.renderer, setup.root, exposure, progress, NeedsDepth(options, in), {}};
+  const std::string background_lines = RenderBackground(run, setup.sweep_screens, background_s, kept.background_lines);
+  exposure.ForgetLastFrames();
+  const std::string truth_lines = RenderSequence(run, blur, kept.frame_lines);
+  AtomicWriteFile(setup.root / "truth" / "frames.jsonl", truth_lines);
+  AtomicWriteFile(setup.root / "truth" / "background.jsonl", background_lines);
+  WriteMotionTruth(setup.root, in);
+  Log().info("render: {} frame-sets ({} cameras) in {:.1f} s", options.background_frames + in.frame_count,
+             in.rig.cameras.size(), progress.ElapsedS());
+}
+
+}  // namespace
+
 fs::path RunRenderJob(const RenderJobOptions& options) {
   // 1. Everything from outside is checked before anything is created.
   const RenderInputs in = LoadRenderInputs(options);
@@ -553,35 +640,28 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
   renderer.SetScene(in.scene);
   renderer.SetPersonTopology(in.avatar.indices, in.avatar.bind_vertices.size());
 
-  // 3. The staging folder and the static files.
-  StagingDir staging(out, options.overwrite, "--out");
-  const fs::path root = staging.path();
-  CreateSequenceFolders(root, in, options.write_depth);
-  WriteSequenceCalibration(root, in);
+  // 3. The staging folder (with --resume, a dead render's of the same
+  // options, adopted) and its journal (render_resume.h).
+  StagingDir staging(out, options.overwrite, "--out", "render",
+                     options.resume ? StagingDir::Stale::kAdopt : StagingDir::Stale::kRemove);
+  if (options.resume && !staging.adopted()) Log().info("render: no unfinished render of {} to resume", out.string());
   const nlohmann::json manifest = BuildManifest(options, in, sweep_screens, *context, render_options);
+  const std::string hash = RenderOptionsHash(manifest, RenderInputFiles(in));
+  const RenderLayout layout{CameraNames(in), options.background_frames, in.frame_count, options.write_depth};
+  const RenderSetup setup{options, in, renderer, staging.path(), sweep_screens};
 
-  RenderProgress progress;
-  const int total = options.background_frames + in.frame_count;
-  // The sensor model per camera; background frames come before t = 0.
-  const double background_s = options.background_frames / in.fps;
-  RigExposure exposure(in.rig.cameras, in.rig.timing, in.sensors, in.sensor_active, options.seed, -background_s,
-                       in.frame_count / in.fps);
-  const MotionBlurPlan blur = PlanMotionBlur(in);
-  RenderRun run{options, in, renderer, root, exposure, progress, NeedsDepth(options, in), {}};
-
-  // 4. Empty-stage frames.
-  const std::string background_lines = RenderBackground(run, sweep_screens, background_s);
-  exposure.ForgetLastFrames();
-
-  // 5. The sequence, then the truth files and the manifest.
-  const std::string truth_lines = RenderSequence(run, blur);
-  AtomicWriteFile(root / "truth" / "frames.jsonl", truth_lines);
-  AtomicWriteFile(root / "truth" / "background.jsonl", background_lines);
-  WriteMotionTruth(root, in);
-  WriteManifest(root, manifest);
+  // 4. The frames, then the truth files and the manifest.
+  try {
+    RenderFrameSets(setup, StartRenderJournal(staging, hash, layout));
+  } catch (const ResumeMismatch& e) {
+    Log().warn("render: {}: the kept frames were not rendered this way; starting over", e.what());
+    staging.Clear();
+    RenderFrameSets(setup, StartRenderJournal(staging, hash, layout));
+  }
+  RemoveRenderJournal(staging.path());
+  WriteManifest(staging.path(), manifest);
   ThrowIfCancelled();
   staging.Commit();
-  Log().info("render: {} frame-sets ({} cameras) in {:.1f} s", total, in.rig.cameras.size(), progress.ElapsedS());
   return staging.final_path();
 }
 

@@ -38,6 +38,10 @@ struct RenderJobOptions {
   std::string sensor = "clean";
   std::filesystem::path out;  // empty: renders/<rig>-<avatar>-<motion>-s<seed>
   bool overwrite = false;
+  // Carry on from the frames an interrupted render of the same `out` and the
+  // same options left in its staging folder (render_resume.h); without it a
+  // dead render's staging folder is removed.
+  bool resume = false;
   bool write_depth = false;
   GlBackend backend = GlBackend::kAuto;
   int supersample = 2;
@@ -101,6 +105,8 @@ FrameTruth ComputeFrameTruth(const RenderInputs& inputs,
                              const Renderer& renderer);
 
 // Runs the whole job; returns the final sequence folder. Polls for SIGINT.
+// The folder replaces `out` only when irbench wrote it (--force) and may not
+// hold or lie in an input file (common/atomic_file.h).
 std::filesystem::path RunRenderJob(const RenderJobOptions& options);
 
 }  // namespace irbench

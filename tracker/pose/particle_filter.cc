@@ -10,6 +10,8 @@
 #include <optional>
 #include <utility>
 
+#include "common/cancel.h"
+
 namespace irbench {
 namespace {
 
@@ -271,11 +273,14 @@ BodyPose ProposeParticle(const BodyPose& current,
 std::vector<double> WeighParticles(const std::vector<BodyPose>& particles, const PoseScore& score) {
   const int n = static_cast<int>(particles.size());
   std::vector<double> log_likelihood(n);
+  // Ctrl-C is honoured within a frame: workers stop scoring (an exception
+  // must not leave a worker thread) and the caller's thread throws.
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
+    for (int i = r.start; i < r.end && !CancelRequested(); ++i) {
       log_likelihood[i] = score(particles[i]);
     }
   });
+  ThrowIfCancelled();
   return log_likelihood;
 }
 
@@ -297,12 +302,13 @@ void RefineParticles(const BodyShape& shape,
     std::vector<BodyPose> refined(refine);
     std::vector<double> refined_ll(refine);
     cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
-      for (int j = r.start; j < r.end; ++j) {
+      for (int j = r.start; j < r.end && !CancelRequested(); ++j) {
         refined[j] = RefineIcp(shape, proposed[order[j]], icp_views, options.icp);
         CapRise(shape, options.max_rise_m, &refined[j]);
         refined_ll[j] = score(refined[j]);
       }
     });
+    ThrowIfCancelled();
     for (int j = 0; j < refine; ++j) {
       if (refined_ll[j] > (*log_likelihood)[order[j]]) {
         proposed[order[j]] = refined[j];
