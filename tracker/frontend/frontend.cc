@@ -17,6 +17,7 @@ void FrontEndOptions::Check() const {
   polygons.Check();
   voxels.Check();
   polyhedral.Check();
+  health.Check();
   if (!(placement_max_coverage > 0 && placement_max_coverage <= 1)) {
     throw InputError("", "frontend.placement_max_coverage", "must be in (0, 1]");
   }
@@ -68,6 +69,7 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
   fe.cameras_ = input.cameras();
   for (size_t c = 0; c < input.cameras().size(); ++c) {
     const std::vector<cv::Mat> frames = input.Backgrounds(static_cast<int>(c));
+    fe.empty_stage_means_.push_back(MeanLevel(frames));
     auto model = BackgroundModel::Train(frames, options.background,
                                         ScreenMask(input.cameras()[c], input.screens()));
     auto shadows = ShadowRemover::Train(frames, options.shadow);
@@ -126,13 +128,21 @@ std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, 
   return best;
 }
 
-FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) const {
+int FrameFeatures::UsableCameras() const {
+  int n = 0;
+  for (size_t c = 0; c < cameras.size(); ++c) n += !LeftOut(c);
+  return n;
+}
+
+FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames, const std::vector<bool>& left_out) const {
   const int nc = static_cast<int>(background_.size());
-  if (static_cast<int>(frames.size()) != nc) {
-    throw std::invalid_argument("front end: expected " + std::to_string(nc) + " frames, got " +
-                                std::to_string(frames.size()));
+  if (static_cast<int>(frames.size()) != nc || (!left_out.empty() && static_cast<int>(left_out.size()) != nc)) {
+    throw std::invalid_argument("front end: expected " + std::to_string(nc) + " frames and flags, got " +
+                                std::to_string(frames.size()) + " and " + std::to_string(left_out.size()));
   }
+  auto is_left_out = [&](int c) { return !left_out.empty() && left_out[c]; };
   for (int c = 0; c < nc; ++c) {
+    if (is_left_out(c)) continue;
     if (frames[c].type() != CV_8UC1 || frames[c].cols != cameras_[c].width || frames[c].rows != cameras_[c].height) {
       throw std::invalid_argument("front end: the frame of camera '" + cameras_[c].name +
                                   "' is not 8-bit grey of the camera's size");
@@ -156,6 +166,7 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
   auto t = std::chrono::steady_clock::now();
   FrameFeatures out;
   out.frame = frame;
+  out.left_out = left_out;
   out.cameras.resize(nc);
   out.polygons.resize(nc);
   const bool need_distances = options_.find_axes || carver_;
@@ -164,6 +175,10 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
   // Per camera, ms on its thread: silhouettes, axes, polygons, voxels.
   std::vector<std::array<double, 4>> thread_ms(nc, {0, 0, 0, 0});
   per_camera([&](int c) {
+    if (is_left_out(c)) {
+      LeaveOut(c, need_distances, &out, &silhouettes, &distances, &views);
+      return;
+    }
     auto tc = std::chrono::steady_clock::now();
     const SilhouetteResult r = background_[c].Segment(frames[c]);
     CameraFeatures& cf = out.cameras[c];
@@ -205,22 +220,51 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames) c
     out.views = std::move(views);
     out.ms_axes += since(t);
   }
-  if (carver_) {
+  // Two views at least make a hull; with fewer the stage cannot be seen.
+  if (carver_ && out.UsableCameras() >= 2) {
     t = std::chrono::steady_clock::now();
     out.voxels = carver_->CarveDistances(distances);
     out.placement = PlaceBody(*out.voxels);
-    if (!out.placement && options_.placement_drop_view && silhouettes.size() >= 4 &&
+    if (!out.placement && options_.placement_drop_view && out.UsableCameras() >= 4 &&
         options_.voxels.max_missing_views == 0) {
       out.placement = PlaceBodyWithoutOneView(*carver_, silhouettes, options_.placement_max_coverage, &distances);
     }
     out.ms_voxels += since(t);
   }
-  if (options_.polyhedral_hull) {
+  if (options_.polyhedral_hull && out.UsableCameras() >= 2) {
     t = std::chrono::steady_clock::now();
-    out.hull = PolyhedralVisualHull(cameras_, out.polygons, options_.polyhedral);
+    if (out.UsableCameras() == nc) {
+      out.hull = PolyhedralVisualHull(cameras_, out.polygons, options_.polyhedral);
+    } else {
+      std::vector<Camera> cameras;
+      std::vector<SilhouettePolygons> polygons;
+      for (int c = 0; c < nc; ++c) {
+        if (!is_left_out(c)) cameras.push_back(cameras_[c]), polygons.push_back(out.polygons[c]);
+      }
+      out.hull = PolyhedralVisualHull(cameras, polygons, options_.polyhedral);
+    }
     out.ms_polyhedral = since(t);
   }
   return out;
+}
+
+void FrontEnd::LeaveOut(int c, bool need_distances, FrameFeatures* out, std::vector<cv::Mat>* silhouettes,
+                        std::vector<cv::Mat>* distances, std::vector<AxisView>* views) const {
+  const Camera& cam = cameras_[c];
+  CameraFeatures& cf = out->cameras[c];
+  cf.silhouette = cv::Mat::zeros(cam.height, cam.width, CV_8U);
+  cf.before_shadows = cf.silhouette.clone();
+  (*silhouettes)[c] = cf.silhouette;
+  out->polygons[c].width = cam.width;
+  out->polygons[c].height = cam.height;
+  // Constrains nothing: distance 0 (inside) everywhere, so the hull and the
+  // other views' 3D axis points pass it; no axis points of its own.
+  if (need_distances) (*distances)[c] = cv::Mat(cam.height, cam.width, CV_32F, cv::Scalar(0));
+  if (!views->empty()) {
+    AxisView& view = (*views)[c];
+    view.camera = cam;
+    view.silhouette = cv::Mat(cam.height, cam.width, CV_8U, cv::Scalar(255));
+  }
 }
 
 }  // namespace irbench

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tracker/axis/axis3d.h"
+#include "tracker/frontend/camera_health.h"
 #include "tracker/hull/polygon.h"
 #include "tracker/hull/polyhedral_hull.h"
 #include "tracker/hull/voxel_hull.h"
@@ -43,6 +44,8 @@ struct FrontEndOptions {
   // Built on request (irbench track --ply): nothing downstream uses it yet and
   // it is the front end's most expensive stage.
   bool polyhedral_hull = false;
+  // Which cameras a frame-set is tracked without (irbench track).
+  CameraHealthOptions health;
   void Check() const;  // throws InputError naming the field
 };
 
@@ -51,6 +54,10 @@ struct CameraFeatures {
   cv::Mat before_shadows;  // the background model's mask
   double light_level = 0;
   int blobs_removed = 0;
+  // Filled by the caller that watches the cameras (irbench track): the
+  // frame's state and mean grey level.
+  CameraHealth health = CameraHealth::kOk;
+  double mean_level = 0;
 };
 
 // Where the person stands, from the voxel hull (thesis 6.1.2 places the body
@@ -85,6 +92,13 @@ std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, 
 struct FrameFeatures {
   int frame = 0;
   std::vector<CameraFeatures> cameras;
+  // Per camera: true for a camera left out of this frame-set (its frame
+  // missing, black or frozen: camera_health.h). A left-out camera's
+  // silhouette is empty and it constrains nothing: not the hull, the 3D axis
+  // points or the pose likelihood. Empty: none left out.
+  std::vector<bool> left_out;
+  bool LeftOut(size_t c) const { return c < left_out.size() && left_out[c]; }
+  int UsableCameras() const;
   // Per camera: the 2D axis graph and part labels (thesis 3.2-3.3).
   std::vector<AxisView> views;
   // 3D axis points by epipolar intersection (thesis 4.4.2).
@@ -114,16 +128,26 @@ class FrontEnd {
   // `frames`: one 8-bit image per camera, in the input's camera order, of
   // the camera's size (std::invalid_argument otherwise). The per-camera
   // stages run in parallel over the cameras; the result does not depend on
-  // the thread count.
-  FrameFeatures Process(int frame, const std::vector<cv::Mat>& frames) const;
+  // the thread count. `left_out` (empty, or one flag per camera): cameras to
+  // leave out of this frame-set; their frames may be empty Mats.
+  FrameFeatures Process(int frame, const std::vector<cv::Mat>& frames,
+                        const std::vector<bool>& left_out = {}) const;
 
   const FrontEndOptions& options() const { return options_; }
+  // Per camera, the mean grey level of its empty-stage frames (the camera
+  // health monitor's reference).
+  const std::vector<double>& empty_stage_means() const { return empty_stage_means_; }
 
  private:
+  // Camera c's part of a frame-set it is left out of.
+  void LeaveOut(int c, bool need_distances, FrameFeatures* out, std::vector<cv::Mat>* silhouettes,
+                std::vector<cv::Mat>* distances, std::vector<AxisView>* views) const;
+
   FrontEndOptions options_;
   std::vector<BackgroundModel> background_;
   std::vector<ShadowRemover> shadows_;
   std::vector<Camera> cameras_;
+  std::vector<double> empty_stage_means_;
   std::shared_ptr<const VoxelCarver> carver_;  // its look-up table is built once per rig
 };
 

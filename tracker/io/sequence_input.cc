@@ -1,5 +1,6 @@
 #include "tracker/io/sequence_input.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 
@@ -38,6 +39,21 @@ void CheckNoGap(const fs::path& folder, int count) {
   }
 }
 
+// The numbers of the frame files present ("%06d.png"), sorted.
+std::vector<int> NumberedFiles(const fs::path& folder) {
+  std::vector<int> numbers;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() != 10 || entry.path().extension() != ".png") continue;
+    const std::string stem = name.substr(0, 6);
+    if (stem.find_first_not_of("0123456789") != std::string::npos) continue;
+    numbers.push_back(std::stoi(stem));
+  }
+  std::sort(numbers.begin(), numbers.end());
+  return numbers;
+}
+
 }  // namespace
 
 SequenceInput SequenceInput::Open(const fs::path& dir) {
@@ -48,24 +64,44 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
   in.cameras_ = std::move(calibration.cameras);
   in.timing_ = std::move(calibration.timing);
   in.screens_ = ReadScreens(dir);
+  // The empty-stage frames train the background: numbered without gaps and
+  // the same count in every camera.
   for (size_t c = 0; c < in.cameras_.size(); ++c) {
-    const int frames = CountNumbered(dir / "frames" / in.cameras_[c].name);
-    const int backgrounds = CountNumbered(dir / "background" / in.cameras_[c].name);
-    CheckNoGap(dir / "frames" / in.cameras_[c].name, frames);
-    CheckNoGap(dir / "background" / in.cameras_[c].name, backgrounds);
-    if (frames == 0) {
-      throw InputError((dir / "frames" / in.cameras_[c].name).string(), "", "no frames (000000.png, ...)");
-    }
+    const fs::path folder = dir / "background" / in.cameras_[c].name;
+    const int backgrounds = CountNumbered(folder);
+    CheckNoGap(folder, backgrounds);
     if (c == 0) {
-      in.frame_count_ = frames;
       in.background_count_ = backgrounds;
-    } else if (frames != in.frame_count_ || backgrounds != in.background_count_) {
-      throw InputError((dir / "frames" / in.cameras_[c].name).string(), "",
-                       "camera '" + in.cameras_[c].name + "' has " + std::to_string(frames) + " frames and " +
-                           std::to_string(backgrounds) + " empty-stage frames; '" + in.cameras_[0].name +
-                           "' has " + std::to_string(in.frame_count_) + " and " +
+    } else if (backgrounds != in.background_count_) {
+      throw InputError(folder.string(), "",
+                       "camera '" + in.cameras_[c].name + "' has " + std::to_string(backgrounds) +
+                           " empty-stage frames; '" + in.cameras_[0].name + "' has " +
                            std::to_string(in.background_count_));
     }
+  }
+  // The frames may miss some (a rig loses frames): the sequence runs to the
+  // last frame of any camera. A camera without any frame is an input error.
+  std::vector<std::vector<int>> present(in.cameras_.size());
+  for (size_t c = 0; c < in.cameras_.size(); ++c) {
+    const fs::path folder = dir / "frames" / in.cameras_[c].name;
+    present[c] = NumberedFiles(folder);
+    if (present[c].empty()) throw InputError(folder.string(), "", "no frames (000000.png, ...)");
+    in.frame_count_ = std::max(in.frame_count_, present[c].back() + 1);
+  }
+  std::vector<bool> any(in.frame_count_, false);
+  for (size_t c = 0; c < in.cameras_.size(); ++c) {
+    for (int f : present[c]) any[f] = true;
+    in.missing_frames_.push_back(in.frame_count_ - static_cast<int>(present[c].size()));
+  }
+  // Frame-sets that no camera has, beyond half the sequence: a stray
+  // numbered file, not lost frames.
+  const int none = static_cast<int>(std::count(any.begin(), any.end(), false));
+  if (2 * none > in.frame_count_) {
+    char last[32];
+    std::snprintf(last, sizeof(last), "%06d.png", in.frame_count_ - 1);
+    throw InputError((dir / "frames").string(), "",
+                     std::to_string(none) + " of " + std::to_string(in.frame_count_) +
+                         " frame-sets have no camera's frame (a stray " + last + "?)");
   }
   return in;
 }
@@ -98,6 +134,24 @@ cv::Mat SequenceInput::Load(const fs::path& path, int camera) const {
 }
 
 cv::Mat SequenceInput::Frame(int camera, int frame) const { return Load(FramePath(camera, frame), camera); }
+
+std::vector<cv::Mat> SequenceInput::TryFrameSet(int frame, std::vector<std::string>* problems) const {
+  std::vector<cv::Mat> out(cameras_.size());
+  problems->assign(cameras_.size(), "");
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    const fs::path path = FramePath(static_cast<int>(c), frame);
+    if (!fs::is_regular_file(path)) {
+      (*problems)[c] = path.string() + ": missing";
+      continue;
+    }
+    try {
+      out[c] = Load(path, static_cast<int>(c));
+    } catch (const std::exception& e) {  // InputError, or OpenCV on a mangled file
+      (*problems)[c] = e.what();
+    }
+  }
+  return out;
+}
 
 std::vector<cv::Mat> SequenceInput::FrameSet(int frame) const {
   std::vector<cv::Mat> out;

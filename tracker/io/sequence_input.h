@@ -20,7 +20,10 @@ namespace irbench {
 class SequenceInput {
  public:
   // Throws InputError naming the file and field: a missing or unreadable
-  // calibration, a camera without frames, cameras with different frame counts.
+  // calibration, a camera without any frame, a gap in the empty-stage frames
+  // or cameras with different numbers of them. Frames may be missing (a rig
+  // that lost some): the sequence runs to the last frame of any camera, and
+  // MissingFrames() says what is not there.
   static SequenceInput Open(const std::filesystem::path& dir);
 
   const std::filesystem::path& dir() const { return dir_; }
@@ -37,6 +40,12 @@ class SequenceInput {
   cv::Mat Frame(int camera, int frame) const;
   // Every camera's frame `frame`, in the cameras' order (a frame-set).
   std::vector<cv::Mat> FrameSet(int frame) const;
+  // The same, tolerating faults: an empty Mat for a camera whose frame is
+  // missing, undecodable or of the wrong size, with the reason in `problems`
+  // (one entry per camera, empty when the frame was read).
+  std::vector<cv::Mat> TryFrameSet(int frame, std::vector<std::string>* problems) const;
+  // Per camera, how many frames below frame_count() have no file.
+  const std::vector<int>& MissingFrames() const { return missing_frames_; }
   cv::Mat Background(int camera, int index) const;
   std::vector<cv::Mat> Backgrounds(int camera) const;
 
@@ -52,6 +61,7 @@ class SequenceInput {
   std::vector<ScreenSurface> screens_;
   int frame_count_ = 0;
   int background_count_ = 0;
+  std::vector<int> missing_frames_;
 };
 
 }  // namespace irbench

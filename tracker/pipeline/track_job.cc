@@ -13,6 +13,7 @@
 #include "common/cancel.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "tracker/frontend/camera_health.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/hull/ply.h"
 #include "tracker/pose/pose_tracker.h"
@@ -105,19 +106,15 @@ FrontEndOptions JobFrontEndOptions(const TrackJobOptions& options) {
   return fe_options;
 }
 
-// The output must not replace or sit inside what it reads.
+// The output must not replace, hold or sit inside what it reads: the
+// sequence's frames/, background/, calib/ and the rest-state model
+// (common/atomic_file.h; the StagingDir then replaces only irbench's own).
 void CheckOutputOutsideSequence(const TrackJobOptions& options) {
-  const fs::path seq = fs::weakly_canonical(fs::absolute(options.sequence));
-  const fs::path out_abs =
-      fs::weakly_canonical(fs::absolute(options.out.empty() ? options.sequence / "track" : options.out));
-  auto inside = [](const fs::path& child, const fs::path& parent) {
-    const auto rel = child.lexically_relative(parent);
-    return !rel.empty() && *rel.begin() != "..";
-  };
-  if (inside(seq, out_abs)) throw InputError("", "--out", "would replace the sequence folder itself");
-  for (const char* part : {"frames", "background", "calib", "truth"}) {
-    if (inside(out_abs, seq / part)) throw InputError("", "--out", std::string("lies inside the sequence's ") + part + "/");
-  }
+  const fs::path out = options.out.empty() ? options.sequence / "track" : options.out;
+  std::vector<fs::path> inputs;
+  for (const char* part : {"frames", "background", "calib"}) inputs.push_back(options.sequence / part);
+  inputs.push_back(options.tracker.rest_model.empty() ? DefaultRestModelPath() : options.tracker.rest_model);
+  CheckOutputApart(out, inputs, "--out");
 }
 
 // The rest-state model (pose stage), loaded before any work is done; null
@@ -147,6 +144,8 @@ nlohmann::json CameraFeaturesJson(const FrameFeatures& features, size_t c) {
     }
   }
   nlohmann::json j;
+  j["health"] = CameraHealthName(cf.health);
+  j["mean_level"] = std::round(cf.mean_level * 100) / 100;
   j["polygon_edges"] = c < features.polygons.size() ? features.polygons[c].EdgeCount() : 0;
   j.update({{"silhouette_area", cv::countNonZero(cf.silhouette)},
             {"axis", parts},
@@ -238,7 +237,8 @@ nlohmann::json TrackLine(int f, double t, const FrameFeatures& features, const s
     track_line["arm_thickness"] = std::round(pose->shape.arm_thickness * 1e3) / 1e3;
     nlohmann::json overlap = nlohmann::json::object();
     for (size_t c = 0; c < pose->overlap.size(); ++c) {
-      overlap[cameras[c].name] = std::round(pose->overlap[c] * 1e4) / 1e4;
+      overlap[cameras[c].name] =
+          std::isnan(pose->overlap[c]) ? nlohmann::json(nullptr) : nlohmann::json(std::round(pose->overlap[c] * 1e4) / 1e4);
     }
     line["pose_overlap"] = overlap;
   } else if (!pose && features.placement) {
@@ -247,6 +247,12 @@ nlohmann::json TrackLine(int f, double t, const FrameFeatures& features, const s
     track_line["height_m"] = std::round(features.placement->top_m * 1e3) / 1e3;
   }
   track_line["joints3d"] = joints;
+  // The cameras this frame-set was tracked without, and why (camera_health.h).
+  nlohmann::json left_out = nlohmann::json::object();
+  for (size_t c = 0; c < features.cameras.size(); ++c) {
+    if (features.LeftOut(c)) left_out[cameras[c].name] = CameraHealthName(features.cameras[c].health);
+  }
+  track_line["cameras_left_out"] = left_out;
   return track_line;
 }
 
@@ -271,15 +277,55 @@ struct TrackRun {
   std::optional<PoseTracker>& pose_tracker;
   fs::path root;  // the staging folder
   std::string lines, track_lines;
+  CameraHealthMonitor health;
+  std::vector<CameraHealth> last_health;  // per camera, to warn on changes
+  std::vector<std::map<std::string, int>> left_out_counts;  // per camera, frame-sets by reason
 };
+
+// Reads frame-set f, tolerating faults, and decides which cameras to leave
+// out; warns when a camera's state changes.
+std::vector<cv::Mat> ReadFrameSet(int f, TrackRun& run, std::vector<CameraStatus>* status) {
+  const SequenceInput& input = run.input;
+  std::vector<std::string> problems;
+  std::vector<cv::Mat> images = input.TryFrameSet(f, &problems);
+  *status = run.health.Update(images);
+  for (size_t c = 0; c < images.size(); ++c) {
+    const CameraHealth h = (*status)[c].health;
+    const std::string& name = input.cameras()[c].name;
+    if (h != run.last_health[c] && h == CameraHealth::kOk) {
+      Log().warn("track: camera {} ok again from frame {}", name, f);
+    } else if (h != run.last_health[c]) {
+      Log().warn("track: camera {} {} from frame {}{}{}", name, CameraHealthName(h), f,
+                 problems[c].empty() ? "" : " (" + problems[c] + ")",
+                 h == CameraHealth::kMissing || run.front_end.options().health.leave_out ? ": left out" : "");
+    } else if (!problems[c].empty()) {
+      Log().debug("track: frame {} of camera {} skipped: {}", f, name, problems[c]);
+    }
+    run.last_health[c] = h;
+    // A missing frame is drawn black (silhouettes, overlays).
+    if (images[c].empty()) images[c] = cv::Mat::zeros(input.cameras()[c].height, input.cameras()[c].width, CV_8U);
+  }
+  return images;
+}
 
 // Processes frame f: front end, pose, the silhouettes (and overlays, PLY)
 // written, a line appended to each JSONL.
 void TrackFrame(int f, TrackRun& run) {
   const TrackJobOptions& options = run.options;
   const SequenceInput& input = run.input;
-  const std::vector<cv::Mat> images = input.FrameSet(f);
-  const FrameFeatures features = run.front_end.Process(f, images);
+  std::vector<CameraStatus> status;
+  const std::vector<cv::Mat> images = ReadFrameSet(f, run, &status);
+  std::vector<bool> left_out(status.size());
+  for (size_t c = 0; c < status.size(); ++c) {
+    left_out[c] = status[c].health == CameraHealth::kMissing ||
+                  (!status[c].usable() && run.front_end.options().health.leave_out);
+    if (left_out[c]) ++run.left_out_counts[c][CameraHealthName(status[c].health)];
+  }
+  FrameFeatures features = run.front_end.Process(f, images, left_out);
+  for (size_t c = 0; c < status.size(); ++c) {
+    features.cameras[c].health = status[c].health;
+    features.cameras[c].mean_level = status[c].mean_level;
+  }
   std::optional<PoseEstimate> pose;
   if (run.pose_tracker) pose = run.pose_tracker->Step(features, 1.0 / input.fps());
   nlohmann::json line;
@@ -325,7 +371,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     frames = std::min(frames, *options.frames);
   }
   const fs::path out = options.out.empty() ? options.sequence / "track" : options.out;
-  StagingDir staging(out, options.overwrite, "--out");
+  StagingDir staging(out, options.overwrite, "--out", "track");
   const fs::path root = staging.path();
   if (options.ply) fs::create_directories(root / "hull");
   for (const Camera& cam : input.cameras()) {
@@ -344,7 +390,16 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     pose_tracker.emplace(input.cameras(), input.screens(), settings.pose);
     if (rest_classifier) pose_tracker->set_rest_classifier(rest_classifier);
   }
-  TrackRun run{options, input, front_end, pose_tracker, root, "", ""};
+  const size_t nc = input.cameras().size();
+  TrackRun run{options, input, front_end, pose_tracker, root, "", "",
+               CameraHealthMonitor(front_end.empty_stage_means(), fe_options.health),
+               std::vector<CameraHealth>(nc, CameraHealth::kOk), std::vector<std::map<std::string, int>>(nc)};
+  for (size_t c = 0; c < nc; ++c) {
+    if (input.MissingFrames()[c] > 0) {
+      Log().warn("track: camera {} lacks {} of {} frames; tracked without it there", input.cameras()[c].name,
+                 input.MissingFrames()[c], input.frame_count());
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   auto last_report = start;
   for (int f = 0; f < frames; ++f) {
@@ -363,6 +418,16 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                {"sequence", fs::absolute(options.sequence).lexically_normal().string()},
                {"frames", frames},
                {"train_ms", train_ms}});
+  nlohmann::json left_out = nlohmann::json::object();
+  for (size_t c = 0; c < nc; ++c) {
+    if (run.left_out_counts[c].empty()) continue;
+    left_out[input.cameras()[c].name] = run.left_out_counts[c];
+    int total = 0;
+    for (const auto& [reason, n] : run.left_out_counts[c]) total += n;
+    Log().warn("track: camera {} was left out of {} of {} frame-sets ({})", input.cameras()[c].name, total, frames,
+               nlohmann::json(run.left_out_counts[c]).dump());
+  }
+  meta["cameras_left_out"] = left_out;
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Log().info("track: {} frame-sets in {:.1f} s ({:.1f} ms per frame-set incl. I/O)", frames, seconds,

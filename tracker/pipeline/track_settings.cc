@@ -45,8 +45,14 @@ std::vector<TrackSetting> MakeSettings() {
                                t.stage =
                                    v == "features" ? TrackStage::kFeatures : TrackStage::kPose;
                              }}});
-  s.push_back({"particles", "--particles", "pose: particles of the filter (thesis 6.3)",
-               IntBinding{[](TrackerSettings& t) -> int& { return t.pose.particles; }, 1, 100000}});
+  // The cap: each particle is scored against every camera's silhouette and
+  // a fifth refined by ICP, every frame: measured 0.05-0.07 ms per particle
+  // and frame on 2 cores (lab4, theater4), so 20000 is already 1-1.5 s a
+  // frame; the thesis used 100.
+  s.push_back({"particles", "--particles",
+               "pose: particles of the filter (thesis 6.3), 1-20000 (capped: each costs about\n"
+               "0.05-0.07 ms per frame on 2 cores, so 20000 is already over a second a frame)",
+               IntBinding{[](TrackerSettings& t) -> int& { return t.pose.particles; }, 1, 20000}});
   s.push_back(
       {"refine_fraction", "--refine-fraction",
        "pose: share of the particles refined by 2D-3D ICP each frame (thesis 6.3.3)",
@@ -80,6 +86,20 @@ std::vector<TrackSetting> MakeSettings() {
        "view lost)",
        IntBinding{[](TrackerSettings& t) -> int& { return t.frontend.voxels.max_missing_views; }, 0,
                   1}});
+  s.push_back(
+      {"leave_out_faulty_cameras", "--keep-faulty-cameras",
+       "use every camera's frame even when it is black or frozen (default: such a camera is left out\n"
+       "while it is bad; a missing frame is always left out)",
+       BoolBinding{[](TrackerSettings& t) -> bool& { return t.frontend.health.leave_out; }, false}});
+  s.push_back(
+      {"camera_dark_ratio", "--camera-dark-ratio",
+       "a frame darker than this share of its camera's empty-stage mean (and under 16 grey levels) is\n"
+       "a black camera, 0-0.9",
+       DoubleBinding{[](TrackerSettings& t) -> double& { return t.frontend.health.dark_ratio; }, 0, 0.9}});
+  s.push_back(
+      {"camera_frozen_frames", "--camera-frozen-frames",
+       "a camera repeating its frame this many times while others change is frozen, 1-1000",
+       IntBinding{[](TrackerSettings& t) -> int& { return t.frontend.health.frozen_frames; }, 1, 1000}});
   return s;
 }
 

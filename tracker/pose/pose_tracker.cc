@@ -83,16 +83,27 @@ double PoseTracker::Evaluate(const BodyShape& shape, const BodyPose& pose, const
   double log_likelihood = 0;
   if (overlaps) overlaps->assign(cameras_.size(), 0.0);
   for (size_t c = 0; c < cameras_.size(); ++c) {
+    if (LeftOut(c)) {
+      if (overlaps) (*overlaps)[c] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
     const double r = views[c].OverlapRatio(ProjectBody(cameras_[c], projections_[c], body));
     if (overlaps) (*overlaps)[c] = r;
     log_likelihood += options_.observation.sharpness * std::log(std::max(r, 0.01));
   }
+  // With cameras left out, the same sharpness per rig: the sharpness is set
+  // for the whole rig's sum, and fewer views would otherwise spread the
+  // particles' weights (on theater4 without the overhead camera: shoulders
+  // and neck 10 % closer, the wrists unchanged).
+  const size_t used = cameras_.size() - std::count(left_out_.begin(), left_out_.end(), true);
+  if (used > 0 && used < cameras_.size()) log_likelihood *= static_cast<double>(cameras_.size()) / used;
   return log_likelihood;
 }
 
 bool PoseTracker::HeadSeenByAll(const PosedBody& body, const std::vector<SilhouetteView>& views) const {
   const Eigen::Vector4d head = body.joints[kModelHead].homogeneous();
   for (size_t c = 0; c < cameras_.size(); ++c) {
+    if (LeftOut(c)) continue;
     const Vector3d p = projections_[c] * head;
     if (!(p.z() > 0)) return false;
     const cv::Mat& silhouette = views[c].ideal_silhouette();
@@ -148,7 +159,7 @@ void PoseTracker::MakeViews(const FrameFeatures& features, std::vector<Silhouett
                             std::vector<IcpView>* icp_views) const {
   for (size_t c = 0; c < cameras_.size(); ++c) {
     views->emplace_back(cameras_[c], features.cameras[c].silhouette, map1_[c], map2_[c], options_.observation.scale);
-    if (options_.refine_fraction > 0 && options_.icp.iterations > 0) {
+    if (options_.refine_fraction > 0 && options_.icp.iterations > 0 && !LeftOut(c)) {
       icp_views->push_back({cameras_[c], projections_[c], OutlinePolygons(views->back().ideal_silhouette())});
     }
   }
@@ -260,7 +271,12 @@ std::vector<BodyPose> PoseTracker::ProposeParticles(const FrameFeatures& feature
 bool PoseTracker::EstimateFromBest(const std::vector<BodyPose>& proposed, int best, const FrameFeatures& features,
                                    const std::vector<SilhouetteView>& views, PoseEstimate* out) const {
   out->log_likelihood = Evaluate(proposed[best], views, &out->overlap);
-  const double mean_overlap = std::accumulate(out->overlap.begin(), out->overlap.end(), 0.0) / out->overlap.size();
+  double sum = 0;
+  int seen = 0;
+  for (double r : out->overlap) {
+    if (!std::isnan(r)) sum += r, ++seen;
+  }
+  const double mean_overlap = seen > 0 ? sum / seen : 0.0;
   const bool fits = mean_overlap >= options_.min_overlap;
   out->in_view = InView(features.placement->root);
   out->tracking = fits && out->in_view;
@@ -420,6 +436,7 @@ void PoseTracker::HeadAndPointing(const FrameFeatures& features, const std::vect
 PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   const auto start = std::chrono::steady_clock::now();
   PoseEstimate out;
+  left_out_ = features.left_out;
   if (!features.placement || features.cameras.size() != cameras_.size()) {
     active_ = false;
     lost_ = false;

@@ -46,7 +46,9 @@ struct PoseEstimate {
   BodyShape shape;
   BodyPose pose;
   PosedBody body;
-  std::vector<double> overlap;  // per camera, the best particle's overlap ratio
+  // Per camera, the best particle's overlap ratio; NaN for a camera left out
+  // of the frame-set (FrameFeatures::left_out).
+  std::vector<double> overlap;
   double log_likelihood = 0;
   std::optional<PointingRay> pointing[2];  // right, left; none for an arm at rest
   std::optional<bool> rest[2];              // right, left; none without a rest classifier
@@ -155,6 +157,10 @@ class PoseTracker {
   // stage's centre (walk_dir_), as they face a walk's direction.
   bool entering_ = false;
   bool lost_ = false;
+  // The cameras left out of the current frame-set (FrameFeatures::left_out):
+  // not in the likelihood, the ICP or the head test.
+  std::vector<bool> left_out_;
+  bool LeftOut(size_t c) const { return c < left_out_.size() && left_out_[c]; }
   // Per arm (right, left): seconds since the 3D axis points last showed it
   // lifted (PoseTrackerOptions::rest_lifted_angle_deg); kNever when they
   // have shown it below that angle since, or have not shown it.
