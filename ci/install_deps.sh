@@ -16,6 +16,7 @@ PACKAGES=(
   gnuplot-nox   # the report's plots (irbench score)
   chromium      # the report's test opens it in headless Chromium
   python3       # ci/checks/code_shape.py (a CTest test): function and file sizes, layering
+  clang libclang-rt-14-dev  # ci/sanitize.sh: ASan, UBSan and libFuzzer (fuzz/)
 )
 
 missing=()

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs what is missing (Debian 12), builds, and runs every test.
+# Installs what is missing (Debian 12), builds, and runs every test; then the
+# unit tests and fuzzers under the sanitizers (ci/sanitize.sh).
 # The README's second command and what CI runs (.ci/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,6 +8,9 @@ cd "$(dirname "$0")/.."
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 ctest --test-dir build --output-on-failure -j"$(nproc)"
+# The unit tests under ASan + UBSan (clang, build-san/) and a short run of every
+# fuzzer (docs/fuzzing.md).
+./ci/sanitize.sh
 # The README's first command with a short setting: 60 frames rendered, tracked,
 # scored, the tables printed and report.html written.
 ./ci/demo.sh --frames 60 --out build/ci-demo

@@ -55,6 +55,18 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs,
     const cv::FileNode node = fs[key];
     if (node.empty() || node.isNone()) throw InputError(file, key, "missing");
     if (!node.isMap()) throw InputError(file, key, "not an opencv-matrix");
+    // The declared size is checked before OpenCV allocates it (a garbage
+    // `cols` asked for 48 GiB: found by fuzz/calibration_fuzz).
+    const cv::FileNode node_rows = node["rows"], node_cols = node["cols"], data = node["data"];
+    const int n = rows * cols;
+    const int r = node_rows.isInt() ? static_cast<int>(node_rows) : 0;
+    const int c = node_cols.isInt() ? static_cast<int>(node_cols) : 0;
+    if (r < 1 || c < 1 || r > n || c > n || r * c != n) {
+      throw InputError(file, key, "expected rows: " + std::to_string(rows) + ", cols: " + std::to_string(cols));
+    }
+    if (!data.isSeq() || data.size() != static_cast<size_t>(rows * cols)) {
+      throw InputError(file, key, "expected " + std::to_string(rows * cols) + " values in data");
+    }
     node >> m;
   } catch (const cv::Exception& e) {
     throw InputError(file, key, "not an opencv-matrix: " + e.msg);

@@ -100,6 +100,22 @@ TEST_F(SequenceFormatTest, CalibrationErrorsNameTheKey) {
   }
 }
 
+// A matrix whose declared size is garbage is refused before OpenCV allocates
+// it (fuzz/calibration_fuzz found `cols:` read as 0xc00000030: 48 GiB).
+TEST_F(SequenceFormatTest, AMatrixOfAbsurdSizeIsRefusedBeforeAllocating) {
+  WriteCalibration(dir_, Cameras(), {{}, {}}, {nlohmann::json::object(), nlohmann::json::object()});
+  std::ifstream in(dir_ / "calib/extri.yml");
+  const std::string extri((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = extri.find("cols: 3", extri.find("Rot_overhead"));
+  ASSERT_NE(at, std::string::npos) << extri;
+  for (const std::string& cols : {"cols: 1610612742", "cols: 4", "cols: x", "cols: -3"}) {
+    std::string text = extri;
+    text.replace(at, std::string("cols: 3").size(), cols);
+    std::ofstream(dir_ / "calib/extri.yml") << text;
+    EXPECT_EQ(ReadErrorField(), "Rot_overhead") << cols;
+  }
+}
+
 // Issue 27.3: the tracker reads camera names from calib/intri.yml; names
 // outside [A-Za-z0-9_-] (1-64 characters, not starting with '-') are refused
 // naming the file and the field.

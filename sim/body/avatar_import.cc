@@ -555,7 +555,10 @@ Avatar MakeAvatar(const Rig& rig,
 // Hash of a vertex position rounded to micrometres.
 struct PositionKeyHash {
   size_t operator()(const std::array<int64_t, 3>& k) const {
-    return std::hash<int64_t>()(k[0] * 73856093LL ^ k[1] * 19349663LL ^ k[2] * 83492791LL);
+    // Unsigned: the multiplications wrap instead of overflowing.
+    return std::hash<uint64_t>()(static_cast<uint64_t>(k[0]) * 73856093ull ^
+                                 static_cast<uint64_t>(k[1]) * 19349663ull ^
+                                 static_cast<uint64_t>(k[2]) * 83492791ull);
   }
 };
 
@@ -700,7 +703,7 @@ void TruthRadii(Avatar& avatar,
   for (const auto& [key, joint_fraction] : limbs) {
     const auto [right, fraction] = joint_fraction;
     const bool arm = right <= kRightWrist;
-    avatar.truth_radius[key] = both([&](int s) {
+    avatar.truth_radius[key] = both([&, right = right, fraction = fraction](int s) {
       const int j = s > 0 ? right : Mirror(right);
       return radius(q[j], arm ? Vector3d(s * ux) : uz, fraction * h);
     });
@@ -739,6 +742,13 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
   const std::array<Matrix3d, kJointCount> rot = TPoseRotations(p, file);
   std::array<Vector3d, kJointCount> q = TPoseJoints(p, rot);
   SkinToTPose(verts, weights, p, q, rot);
+  // A rig whose bind matrices are degenerate can throw the mesh anywhere: a
+  // person stays within a kilometre (found by fuzz/gltf_fuzz).
+  for (const Vector3d& v : verts) {
+    if (!v.allFinite() || v.cwiseAbs().maxCoeff() > 1e3) {
+      throw InputError(file, "skins", "re-posed into the T-pose, the mesh is not finite or lies beyond 1 km");
+    }
+  }
   const double h = PlaceOnFloor(verts, q, scale, file);
 
   Avatar avatar = MakeAvatar(rig, path, options, h, q, weights, verts);

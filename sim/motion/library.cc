@@ -564,7 +564,7 @@ MotionPtr Walk(const std::string& name, const Eigen::Vector2d& to, std::optional
   const Skeleton sk = b.sk_;
   const double stride = 1.25 * sk.bind_position[kPelvis].z() / 0.93;  // metres per gait cycle
   const double total = t_turn1 + t_walk + t_turn2;
-  auto f = [=](double t) {
+  auto f = [=, turn1 = turn1, t_turn1 = t_turn1, turn2 = turn2, t_turn2 = t_turn2](double t) {
     BodyPose body = base;
     double progress = 0;  // distance walked
     if (t < t_turn1) {

@@ -107,7 +107,7 @@ void ApplyKnobs(const nlohmann::json& knobs, const std::string& file, const std:
   if (!knobs.is_object()) throw InputError(file, field, "expected an object");
   for (const auto& [key, value] : knobs.items()) {
     bool known = false;
-    VisitKnobs(*params, [&](const char* name, auto& member) {
+    VisitKnobs(*params, [&, &key = key, &value = value](const char* name, auto& member) {
       if (key != name) return;
       known = true;
       using T = std::decay_t<decltype(member)>;

@@ -43,7 +43,7 @@ struct ScanLines {
   std::pair<int, int> RangeIn(int k, const cv::Rect& box) const {
     auto [lo, hi] = Range(k);
     const int x0 = box.x, x1 = box.x + box.width - 1, y0 = box.y, y1 = box.y + box.height - 1;
-    auto clip = [&](int a, int b) {
+    auto clip = [&lo = lo, &hi = hi](int a, int b) {
       lo = std::max(lo, a);
       hi = std::min(hi, b);
     };
