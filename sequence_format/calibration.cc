@@ -1,6 +1,7 @@
 #include "sequence_format/calibration.h"
 
 #include <cmath>
+#include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
@@ -81,11 +82,39 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs,
   return m.reshape(1, rows);
 }
 
+// OpenCV's YAML parser (4.6, Debian 12) never returns on some malformed
+// files (fuzz/calibration_fuzz: a second `%YAML` directive after a `---`
+// marker). Calibration files are OpenCV's own layout: one `%YAML` directive on
+// the first line, `---` only alone on its line; anything else is refused
+// before the parser sees it. Also bounds the size (a rig of a thousand
+// cameras is under 1 MB).
+void CheckYamlShape(const fs::path& file) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  if (ec) throw InputError(file.string(), "", "unreadable");
+  if (size > (8u << 20)) throw InputError(file.string(), "", "over 8 MB: not a calibration file");
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    const bool directive = line.rfind("%", 0) == 0;
+    if (n == 1 && !(directive && line.rfind("%YAML", 0) == 0)) {
+      throw InputError(file.string(), "", "line 1: expected the %YAML:1.0 directive of an OpenCV YAML file");
+    }
+    if ((n > 1 && directive) || (line.rfind("---", 0) == 0 && line != "---")) {
+      throw InputError(file.string(), "", "line " + std::to_string(n) + ": not OpenCV's YAML layout ('" +
+                                              line.substr(0, 40) + "')");
+    }
+  }
+}
+
 // Opens both FileStorage files for reading; InputError naming the one that fails.
 void OpenYaml(const fs::path& intri_file,
               const fs::path& extri_file,
               cv::FileStorage* intri,
               cv::FileStorage* extri) {
+  CheckYamlShape(intri_file);
+  CheckYamlShape(extri_file);
   try {
     intri->open(intri_file.string(), cv::FileStorage::READ);
     extri->open(extri_file.string(), cv::FileStorage::READ);

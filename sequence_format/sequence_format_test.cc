@@ -116,6 +116,22 @@ TEST_F(SequenceFormatTest, AMatrixOfAbsurdSizeIsRefusedBeforeAllocating) {
   }
 }
 
+// OpenCV 4.6's YAML parser never returns on some malformed files (found by
+// fuzz/calibration_fuzz); files not in OpenCV's own layout are refused first.
+TEST_F(SequenceFormatTest, YamlOutsideOpenCvsLayoutIsRefusedBeforeParsing) {
+  WriteCalibration(dir_, Cameras(), {{}, {}}, {nlohmann::json::object(), nlohmann::json::object()});
+  for (const std::string& text : {std::string("%YAML:1.0\n---%YAML:1.0\n\nna---\nnme"),  // the hang
+                                  std::string("names: [a]\n"), std::string("%YAML:1.0\n---\n%TAG ! x\n")}) {
+    std::ofstream(dir_ / "calib/intri.yml") << text;
+    try {
+      ReadCalibration(dir_);
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(fs::path(e.file()).filename(), "intri.yml") << e.what();
+    }
+  }
+}
+
 // Issue 27.3: the tracker reads camera names from calib/intri.yml; names
 // outside [A-Za-z0-9_-] (1-64 characters, not starting with '-') are refused
 // naming the file and the field.

@@ -91,12 +91,6 @@ double PoseTracker::Evaluate(const BodyShape& shape, const BodyPose& pose, const
     if (overlaps) (*overlaps)[c] = r;
     log_likelihood += options_.observation.sharpness * std::log(std::max(r, 0.01));
   }
-  // With cameras left out, the same sharpness per rig: the sharpness is set
-  // for the whole rig's sum, and fewer views would otherwise spread the
-  // particles' weights (on theater4 without the overhead camera: shoulders
-  // and neck 10 % closer, the wrists unchanged).
-  const size_t used = cameras_.size() - std::count(left_out_.begin(), left_out_.end(), true);
-  if (used > 0 && used < cameras_.size()) log_likelihood *= static_cast<double>(cameras_.size()) / used;
   return log_likelihood;
 }
 
