@@ -108,7 +108,7 @@ TEST_F(SequenceFormatTest, AMatrixOfAbsurdSizeIsRefusedBeforeAllocating) {
   const std::string extri((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const size_t at = extri.find("cols: 3", extri.find("Rot_overhead"));
   ASSERT_NE(at, std::string::npos) << extri;
-  for (const std::string& cols : {"cols: 1610612742", "cols: 4", "cols: x", "cols: -3"}) {
+  for (const char* cols : {"cols: 1610612742", "cols: 4", "cols: x", "cols: -3"}) {
     std::string text = extri;
     text.replace(at, std::string("cols: 3").size(), cols);
     std::ofstream(dir_ / "calib/extri.yml") << text;
