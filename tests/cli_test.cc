@@ -60,7 +60,8 @@ TEST(CliTest, HelpOnEveryCommand) {
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
         {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
         {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
-        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}, {"suite", "run", "--help"}}) {
+        {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}, {"suite", "run", "--help"},
+        {"fault", "--help"}, {"train", "rest", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
