@@ -24,21 +24,32 @@ void CameraHealthOptions::Check() const {
   if (frozen_frames < 1 || frozen_frames > 1000) throw InputError("", "health.frozen_frames", "must be in 1..1000");
 }
 
-double MeanLevel(const std::vector<cv::Mat>& images) {
+CameraReference ReferenceFromEmptyStage(const std::vector<cv::Mat>& frames) {
+  CameraReference r;
   double sum = 0;
-  for (const cv::Mat& image : images) sum += cv::mean(image)[0];
-  return images.empty() ? 0.0 : sum / images.size();
+  for (const cv::Mat& image : frames) sum += cv::mean(image)[0];
+  r.mean_level = frames.empty() ? 0.0 : sum / frames.size();
+  // Noisy when every consecutive pair differs in 5 % of the pixels or more
+  // (the thesis preset: about half of them; the clean preset: none).
+  r.noisy = frames.size() >= 2;
+  for (size_t i = 1; i < frames.size() && r.noisy; ++i) {
+    if (frames[i].size() != frames[i - 1].size() || frames[i].type() != frames[i - 1].type()) continue;
+    cv::Mat diff;
+    cv::absdiff(frames[i], frames[i - 1], diff);
+    r.noisy = cv::countNonZero(diff.reshape(1)) >= 0.05 * diff.total() * diff.channels();
+  }
+  return r;
 }
 
-CameraHealthMonitor::CameraHealthMonitor(std::vector<double> empty_stage_means, const CameraHealthOptions& options)
-    : options_(options), empty_stage_means_(std::move(empty_stage_means)) {
+CameraHealthMonitor::CameraHealthMonitor(std::vector<CameraReference> references, const CameraHealthOptions& options)
+    : options_(options), references_(std::move(references)) {
   options_.Check();
-  previous_.resize(empty_stage_means_.size());
-  repeats_.assign(empty_stage_means_.size(), 0);
+  previous_.resize(references_.size());
+  repeats_.assign(references_.size(), 0);
 }
 
 std::vector<CameraStatus> CameraHealthMonitor::Update(const std::vector<cv::Mat>& frames) {
-  const size_t n = empty_stage_means_.size();
+  const size_t n = references_.size();
   if (frames.size() != n) {
     throw InputError("", "frames", "expected " + std::to_string(n) + " frames, got " + std::to_string(frames.size()));
   }
@@ -67,9 +78,9 @@ std::vector<CameraStatus> CameraHealthMonitor::Update(const std::vector<cv::Mat>
       ++repeats_[c];
     }
     previous_[c] = frames[c];
-    if (s.mean_level < options_.dark_max_level && s.mean_level < options_.dark_ratio * empty_stage_means_[c]) {
+    if (s.mean_level < options_.dark_max_level && s.mean_level < options_.dark_ratio * references_[c].mean_level) {
       s.health = CameraHealth::kDark;
-    } else if (repeats_[c] >= options_.frozen_frames) {
+    } else if (references_[c].noisy && repeats_[c] >= options_.frozen_frames) {
       s.health = CameraHealth::kFrozen;
     }
   }

@@ -27,14 +27,25 @@ struct CameraHealthOptions {
   double dark_ratio = 0.2;
   double dark_max_level = 16;
   // Frozen: byte-identical to the camera's previous frame on this many
-  // consecutive frame-sets in which some other camera's frame changed (a still
-  // scene through a noise-free sensor repeats in every camera and is no fault).
+  // consecutive frame-sets in which some other camera's frame changed; only
+  // for a camera whose sensor shows noise (CameraReference::noisy).
   int frozen_frames = 2;
   // false: report the states but use every readable frame (a missing frame
   // is always left out: there is nothing to use).
   bool leave_out = true;
   void Check() const;  // throws InputError naming the field
 };
+
+// What the health monitor knows of a camera from its empty-stage frames: their
+// mean grey level, and whether its sensor shows noise (consecutive empty-stage
+// frames differ in at least 5 % of their pixels). A noise-free camera (the
+// sim's `clean` preset) repeats its frame whenever nothing moves in its view,
+// so a frozen one cannot be told from a still one: it is never called frozen.
+struct CameraReference {
+  double mean_level = 0;
+  bool noisy = false;
+};
+CameraReference ReferenceFromEmptyStage(const std::vector<cv::Mat>& empty_stage_frames);
 
 struct CameraStatus {
   CameraHealth health = CameraHealth::kOk;
@@ -44,9 +55,8 @@ struct CameraStatus {
 
 class CameraHealthMonitor {
  public:
-  // `empty_stage_means`: per camera, the mean grey level of its empty-stage
-  // frames.
-  CameraHealthMonitor(std::vector<double> empty_stage_means, const CameraHealthOptions& options = {});
+  // `references`: per camera, from its empty-stage frames.
+  CameraHealthMonitor(std::vector<CameraReference> references, const CameraHealthOptions& options = {});
 
   // One frame-set in order: per camera an 8-bit image, or an empty Mat for a
   // frame that could not be read. Returns each camera's state for this set.
@@ -54,12 +64,10 @@ class CameraHealthMonitor {
 
  private:
   CameraHealthOptions options_;
-  std::vector<double> empty_stage_means_;
+  std::vector<CameraReference> references_;
   std::vector<cv::Mat> previous_;
   std::vector<int> repeats_;  // consecutive identical frames while others changed
 };
 
-// Mean grey level of a set of 8-bit images (0 for none).
-double MeanLevel(const std::vector<cv::Mat>& images);
 
 }  // namespace irbench

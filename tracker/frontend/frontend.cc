@@ -69,7 +69,7 @@ FrontEnd FrontEnd::Train(const SequenceInput& input, const FrontEndOptions& opti
   fe.cameras_ = input.cameras();
   for (size_t c = 0; c < input.cameras().size(); ++c) {
     const std::vector<cv::Mat> frames = input.Backgrounds(static_cast<int>(c));
-    fe.empty_stage_means_.push_back(MeanLevel(frames));
+    fe.camera_references_.push_back(ReferenceFromEmptyStage(frames));
     auto model = BackgroundModel::Train(frames, options.background,
                                         ScreenMask(input.cameras()[c], input.screens()));
     auto shadows = ShadowRemover::Train(frames, options.shadow);

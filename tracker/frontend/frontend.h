@@ -134,9 +134,8 @@ class FrontEnd {
                         const std::vector<bool>& left_out = {}) const;
 
   const FrontEndOptions& options() const { return options_; }
-  // Per camera, the mean grey level of its empty-stage frames (the camera
-  // health monitor's reference).
-  const std::vector<double>& empty_stage_means() const { return empty_stage_means_; }
+  // Per camera, what its empty-stage frames say for the camera health monitor.
+  const std::vector<CameraReference>& camera_references() const { return camera_references_; }
 
  private:
   // Camera c's part of a frame-set it is left out of.
@@ -147,7 +146,7 @@ class FrontEnd {
   std::vector<BackgroundModel> background_;
   std::vector<ShadowRemover> shadows_;
   std::vector<Camera> cameras_;
-  std::vector<double> empty_stage_means_;
+  std::vector<CameraReference> camera_references_;
   std::shared_ptr<const VoxelCarver> carver_;  // its look-up table is built once per rig
 };
 

@@ -392,7 +392,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   }
   const size_t nc = input.cameras().size();
   TrackRun run{options, input, front_end, pose_tracker, root, "", "",
-               CameraHealthMonitor(front_end.empty_stage_means(), fe_options.health),
+               CameraHealthMonitor(front_end.camera_references(), fe_options.health),
                std::vector<CameraHealth>(nc, CameraHealth::kOk), std::vector<std::map<std::string, int>>(nc)};
   for (size_t c = 0; c < nc; ++c) {
     if (input.MissingFrames()[c] > 0) {
