@@ -83,29 +83,66 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs,
 }
 
 // OpenCV's YAML parser (4.6, Debian 12) never returns on some malformed
-// files (fuzz/calibration_fuzz: a second `%YAML` directive after a `---`
-// marker). Calibration files are OpenCV's own layout: one `%YAML` directive on
-// the first line, `---` only alone on its line; anything else is refused
-// before the parser sees it. Also bounds the size (a rig of a thousand
-// cameras is under 1 MB).
-void CheckYamlShape(const fs::path& file) {
+// files (fuzz/calibration_fuzz found several: a second `%YAML` directive after
+// `---`; an indented first key followed by `--` and `-`). So a calibration
+// file must be in the layout OpenCV itself writes, checked line by line
+// before the parser sees it: `%YAML` on line 1, `---` only as line 2; no
+// control characters; top-level `key:` lines at column 0 (key [A-Za-z0-9_-]); indented lines
+// only under a top-level key: `- item` under a list key, `rows:`, `cols:`,
+// `dt:`, `data:` under an `!!opencv-matrix`; a `[ ... ]` may run over lines of
+// values. Also bounds the size (a rig of a thousand cameras is under 1 MB).
+void CheckYamlLayout(const fs::path& file) {
   std::error_code ec;
   const auto size = fs::file_size(file, ec);
   if (ec) throw InputError(file.string(), "", "unreadable");
   if (size > (8u << 20)) throw InputError(file.string(), "", "over 8 MB: not a calibration file");
   std::ifstream in(file, std::ios::binary);
+  enum class Block { kNone, kList, kMatrix } block = Block::kNone;
+  bool in_flow = false;  // inside a [ ... ] that runs over lines
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
+    auto refuse = [&](const std::string& why) {
+      throw InputError(file.string(), "", "line " + std::to_string(n) + ": not OpenCV's YAML layout: " + why);
+    };
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-    const bool directive = line.rfind("%", 0) == 0;
-    if (n == 1 && !(directive && line.rfind("%YAML", 0) == 0)) {
-      throw InputError(file.string(), "", "line 1: expected the %YAML:1.0 directive of an OpenCV YAML file");
+    for (unsigned char ch : line) {
+      if (ch < 0x20 || ch == 0x7f) refuse("a control character");
     }
-    if ((n > 1 && directive) || (line.rfind("---", 0) == 0 && line != "---")) {
-      throw InputError(file.string(), "", "line " + std::to_string(n) + ": not OpenCV's YAML layout ('" +
-                                              line.substr(0, 40) + "')");
+    if (n == 1) {
+      if (line.rfind("%YAML", 0) != 0) refuse("expected the %YAML:1.0 directive");
+      continue;
     }
+    if ((n == 2 && line == "---") || line.empty()) continue;
+    const size_t indent = line.find_first_not_of(' ');
+    const std::string body = line.substr(indent);
+    if (body[0] == '#') continue;
+    if (in_flow) {
+      if (body.find_first_of("[:{}%") != std::string::npos || body.rfind("--", 0) == 0) {
+        refuse("expected values inside [ ]");
+      }
+      in_flow = body.find(']') == std::string::npos;
+      continue;
+    }
+    const size_t colon = body.find(':');
+    const std::string key = body.substr(0, colon);
+    const std::string value = colon == std::string::npos ? "" : body.substr(colon + 1);
+    if (indent == 0) {
+      if (colon == std::string::npos || key.empty() || key.find_first_not_of(
+              "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos) {
+        refuse("expected 'key:' at the start of the line");
+      }
+      block = value.empty() ? Block::kList : value == " !!opencv-matrix" ? Block::kMatrix : Block::kNone;
+    } else if (block == Block::kList) {
+      if (body.rfind("- ", 0) != 0 || body.size() < 3) refuse("expected '- item' under a list");
+      continue;
+    } else if (block == Block::kMatrix) {
+      if (key != "rows" && key != "cols" && key != "dt" && key != "data") refuse("expected rows, cols, dt or data");
+    } else {
+      refuse("an indented line outside a list or matrix");
+    }
+    if (value.rfind(" [", 0) == 0) in_flow = value.find(']') == std::string::npos;
   }
+  if (in_flow) throw InputError(file.string(), "", "a [ ... ] that does not close");
 }
 
 // Opens both FileStorage files for reading; InputError naming the one that fails.
@@ -113,8 +150,8 @@ void OpenYaml(const fs::path& intri_file,
               const fs::path& extri_file,
               cv::FileStorage* intri,
               cv::FileStorage* extri) {
-  CheckYamlShape(intri_file);
-  CheckYamlShape(extri_file);
+  CheckYamlLayout(intri_file);
+  CheckYamlLayout(extri_file);
   try {
     intri->open(intri_file.string(), cv::FileStorage::READ);
     extri->open(extri_file.string(), cv::FileStorage::READ);

@@ -120,8 +120,11 @@ TEST_F(SequenceFormatTest, AMatrixOfAbsurdSizeIsRefusedBeforeAllocating) {
 // fuzz/calibration_fuzz); files not in OpenCV's own layout are refused first.
 TEST_F(SequenceFormatTest, YamlOutsideOpenCvsLayoutIsRefusedBeforeParsing) {
   WriteCalibration(dir_, Cameras(), {{}, {}}, {nlohmann::json::object(), nlohmann::json::object()});
-  for (const std::string& text : {std::string("%YAML:1.0\n---%YAML:1.0\n\nna---\nnme"),  // the hang
-                                  std::string("names: [a]\n"), std::string("%YAML:1.0\n---\n%TAG ! x\n")}) {
+  for (const std::string& text :
+       {std::string("%YAML:1.0\n---%YAML:1.0\n\nna---\nnme"), std::string("%YAML:1.0\n s: 3\n--\n-"),  // hangs
+        std::string("names: [a]\n"), std::string("%YAML:1.0\n---\n%TAG ! x\n"),
+        std::string("%YAML:1.0\nnames:\n   front_left\n"), std::string("%YAML:1.0\nK: !!opencv-matrix\n   foo: 1\n"),
+        std::string("%YAML:1.0\nK: !!opencv-matrix\n   data: [ 1, 2,\n"), std::string("%YAML:1.0\nnames:\n   - k\xc3\xbc\n")}) {
     std::ofstream(dir_ / "calib/intri.yml") << text;
     try {
       ReadCalibration(dir_);
