@@ -140,9 +140,11 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames, c
     throw std::invalid_argument("front end: expected " + std::to_string(nc) + " frames and flags, got " +
                                 std::to_string(frames.size()) + " and " + std::to_string(left_out.size()));
   }
-  auto is_left_out = [&](int c) { return !left_out.empty() && left_out[c]; };
+  FrameFeatures out;
+  out.frame = frame;
+  out.left_out = left_out;
   for (int c = 0; c < nc; ++c) {
-    if (is_left_out(c)) continue;
+    if (out.LeftOut(c)) continue;
     if (frames[c].type() != CV_8UC1 || frames[c].cols != cameras_[c].width || frames[c].rows != cameras_[c].height) {
       throw std::invalid_argument("front end: the frame of camera '" + cameras_[c].name +
                                   "' is not 8-bit grey of the camera's size");
@@ -164,9 +166,6 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames, c
   // shared among its stages in proportion to the time each took on its
   // thread, so the stage times still add up to the front end's.
   auto t = std::chrono::steady_clock::now();
-  FrameFeatures out;
-  out.frame = frame;
-  out.left_out = left_out;
   out.cameras.resize(nc);
   out.polygons.resize(nc);
   const bool need_distances = options_.find_axes || carver_;
@@ -175,7 +174,7 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames, c
   // Per camera, ms on its thread: silhouettes, axes, polygons, voxels.
   std::vector<std::array<double, 4>> thread_ms(nc, {0, 0, 0, 0});
   per_camera([&](int c) {
-    if (is_left_out(c)) {
+    if (out.LeftOut(c)) {
       LeaveOut(c, need_distances, &out, &silhouettes, &distances, &views);
       return;
     }
@@ -239,7 +238,7 @@ FrameFeatures FrontEnd::Process(int frame, const std::vector<cv::Mat>& frames, c
       std::vector<Camera> cameras;
       std::vector<SilhouettePolygons> polygons;
       for (int c = 0; c < nc; ++c) {
-        if (!is_left_out(c)) cameras.push_back(cameras_[c]), polygons.push_back(out.polygons[c]);
+        if (!out.LeftOut(c)) cameras.push_back(cameras_[c]), polygons.push_back(out.polygons[c]);
       }
       out.hull = PolyhedralVisualHull(cameras, polygons, options_.polyhedral);
     }

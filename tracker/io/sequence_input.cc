@@ -22,23 +22,6 @@ int CountNumbered(const fs::path& folder) {
   }
 }
 
-// Frames are numbered from 0 without gaps: a gap with later frames behind it
-// is an error, not the end of the sequence.
-void CheckNoGap(const fs::path& folder, int count) {
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() != 10 || entry.path().extension() != ".png") continue;
-    const std::string stem = name.substr(0, 6);
-    if (stem.find_first_not_of("0123456789") != std::string::npos) continue;
-    if (std::stoi(stem) > count) {
-      char missing[32];
-      std::snprintf(missing, sizeof(missing), "%06d.png", count);
-      throw InputError(folder.string(), "", std::string(missing) + " is missing while later frames exist");
-    }
-  }
-}
-
 // The numbers of the frame files present ("%06d.png"), sorted.
 std::vector<int> NumberedFiles(const fs::path& folder) {
   std::vector<int> numbers;
@@ -52,6 +35,17 @@ std::vector<int> NumberedFiles(const fs::path& folder) {
   }
   std::sort(numbers.begin(), numbers.end());
   return numbers;
+}
+
+// Frames are numbered from 0 without gaps: a gap with later frames behind it
+// is an error, not the end of the sequence.
+void CheckNoGap(const fs::path& folder, int count) {
+  const std::vector<int> numbers = NumberedFiles(folder);
+  if (!numbers.empty() && numbers.back() > count) {
+    char missing[32];
+    std::snprintf(missing, sizeof(missing), "%06d.png", count);
+    throw InputError(folder.string(), "", std::string(missing) + " is missing while later frames exist");
+  }
 }
 
 }  // namespace
