@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <opencv2/calib3d.hpp>
 #include <random>
+#include <unistd.h>
 
 #include "common/error.h"
 #include "geometry/camera.h"
@@ -74,7 +75,7 @@ class RigErrorTest : public ::testing::Test {
  protected:
   std::string Write(const std::string& text) {
     const auto path = std::filesystem::temp_directory_path() /
-                      ("irbench_rig_" + std::to_string(counter_++) + ".json");
+                      ("irbench_rig_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++) + ".json");
     FILE* f = std::fopen(path.c_str(), "w");
     std::fputs(text.c_str(), f);
     std::fclose(f);
