@@ -70,7 +70,8 @@ namespace irbench {
   X(PFNGLFINISHPROC, Finish)                                           \
   X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                             \
   X(PFNGLTEXIMAGE3DPROC, TexImage3D)                                   \
-  X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, FramebufferTextureLayer)
+  X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, FramebufferTextureLayer)       \
+  X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)
 
 struct GlFunctions {
 #define IRBENCH_GL_MEMBER(type, name) type name = nullptr;

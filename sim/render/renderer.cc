@@ -93,7 +93,7 @@ float ShadowDepth(int slot, vec2 uv) { return texture(u_shadow_maps, vec3(uv, fl
 // cross-section at that depth, so the penumbra grows as size * (z_r - z_b) / z_b.
 // Depth comparisons follow the receiver's plane (its depth gradient in uv), so
 // wide kernels do not shadow the receiver itself.
-float Visibility(int slot, vec3 p) {
+float Visibility(int slot, vec3 p, int search_count) {
   vec4 clip = u_shadow_clip_from_world[slot] * vec4(p, 1.0);
   if (clip.w <= 0.0) return 1.0;
   vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
@@ -111,25 +111,22 @@ float Visibility(int slot, vec3 p) {
   float search = max(3.0 * size / z_r, 2.0 * texel);
   float blockers = 0.0;
   float depth_sum = 0.0;
-  for (int j = 0; j < 3; ++j) {
-    for (int k = 0; k < 3; ++k) {
-      vec2 o = (vec2(j, k) / 2.0 - 0.5) * search;
+  for (int i = 0; i < search_count; ++i) {
+      vec2 o = (vec2(i / 3, i % 3) / 2.0 - 0.5) * search;
       float d = ShadowDepth(slot, uv + o);
       if (d < z_r + dot(dz_duv, o) - bias) {
         depth_sum += d;
         blockers += 1.0;
       }
-    }
   }
   if (blockers == 0.0) return 1.0;
   float z_b = depth_sum / blockers;
   float width = max(size * (z_r - z_b) / (z_r * z_b), texel);
   float lit = 0.0;
-  for (int j = 0; j < 5; ++j) {
-    for (int k = 0; k < 5; ++k) {
-      vec2 o = ((vec2(j, k) + 0.5) / 5.0 - 0.5) * width;
+  int count = blockers > 0.0 ? 25 : 0;
+  for (int i = 0; i < count; ++i) {
+      vec2 o = ((vec2(i / 5, i % 5) + 0.5) / 5.0 - 0.5) * width;
       lit += ShadowDepth(slot, uv + o) < z_r + dot(dz_duv, o) - bias ? 0.0 : 1.0;
-    }
   }
   return lit / 25.0;
 }
@@ -154,7 +151,7 @@ void main() {
       float vis = 1.0;
       int slot = u_light_shadow_slot[i];
 #if SHADOWS
-      if (slot >= 0 && cone * lambert > 0.0) vis = Visibility(slot, v_world);
+      if (slot >= 0) vis = Visibility(slot, v_world, cone * lambert > 0.0 ? 9 : 0);
 #endif
       float e = u_light_power[i] * cone * lambert * vis / d2;
       if (u_light_band[i] == 0) irradiance.x += e; else irradiance.y += e;
@@ -263,6 +260,7 @@ void RenderOptions::Check() const {
 
 struct Renderer::ShadowMap {
   unsigned fbo = 0, depth_rbo = 0;
+  unsigned static_fbo = 0, static_depth_rbo = 0;  // the static scene alone
   Eigen::Matrix4f clip_from_world, cam_from_world;
 };
 
@@ -395,8 +393,11 @@ Renderer::~Renderer() {
   for (auto& m : shadow_maps_) {
     gl.DeleteFramebuffers(1, &m->fbo);
     gl.DeleteRenderbuffers(1, &m->depth_rbo);
+    gl.DeleteFramebuffers(1, &m->static_fbo);
+    gl.DeleteRenderbuffers(1, &m->static_depth_rbo);
   }
   if (shadow_array_ != 0) gl.DeleteTextures(1, &shadow_array_);
+  if (static_shadow_array_ != 0) gl.DeleteTextures(1, &static_shadow_array_);
   gl.DeleteVertexArrays(1, &static_vao_);
   gl.DeleteVertexArrays(1, &person_vao_);
   gl.DeleteProgram(program_);
@@ -512,6 +513,7 @@ void Renderer::SetStaticMesh(const TriangleMesh& input) {
   static_index_count_ = static_cast<int>(mesh.indices.size());
   gl.BindVertexArray(0);
   shadows_dirty_ = true;
+  static_shadows_dirty_ = true;
 }
 
 void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
@@ -528,18 +530,23 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   for (auto& m : shadow_maps_) {
     gl.DeleteFramebuffers(1, &m->fbo);
     gl.DeleteRenderbuffers(1, &m->depth_rbo);
+    gl.DeleteFramebuffers(1, &m->static_fbo);
+    gl.DeleteRenderbuffers(1, &m->static_depth_rbo);
   }
   shadow_maps_.clear();
   if (options_.shadows && shadow_array_ == 0) {
-    // Four layers of camera-frame z, one per shadowing light.
-    gl.GenTextures(1, &shadow_array_);
-    gl.BindTexture(GL_TEXTURE_2D_ARRAY, shadow_array_);
-    gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, options_.shadow_map_size, options_.shadow_map_size, 4,
-                  0, GL_RED, GL_FLOAT, nullptr);
-    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    // Four layers of camera-frame z, one per shadowing light, and the same
+    // for the static scene alone.
+    for (unsigned* array : {&shadow_array_, &static_shadow_array_}) {
+      gl.GenTextures(1, array);
+      gl.BindTexture(GL_TEXTURE_2D_ARRAY, *array);
+      gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, options_.shadow_map_size, options_.shadow_map_size, 4,
+                    0, GL_RED, GL_FLOAT, nullptr);
+      gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
   }
   for (int i = 0; i < n; ++i) {
     const IrLight& light = lights[i];
@@ -564,19 +571,24 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
     auto map = std::make_unique<ShadowMap>();
     map->cam_from_world = view.cam_from_world.matrix().cast<float>();
     map->clip_from_world = ClipFromCam(view, options_.near_m, options_.far_m) * map->cam_from_world;
-    gl.GenFramebuffers(1, &map->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, map->fbo);
-    gl.FramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_array_, 0,
-                               static_cast<GLint>(shadow_maps_.size()));
-    gl.GenRenderbuffers(1, &map->depth_rbo);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, map->depth_rbo);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size, size);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, map->depth_rbo);
-    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
-    gl.DrawBuffers(1, buffers);
-    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw RuntimeError("shadow framebuffer incomplete");
-    }
+    const auto make_target = [&](unsigned array, unsigned* fbo, unsigned* depth_rbo) {
+      gl.GenFramebuffers(1, fbo);
+      gl.BindFramebuffer(GL_FRAMEBUFFER, *fbo);
+      gl.FramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, array, 0,
+                                 static_cast<GLint>(shadow_maps_.size()));
+      gl.GenRenderbuffers(1, depth_rbo);
+      gl.BindRenderbuffer(GL_RENDERBUFFER, *depth_rbo);
+      gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size, size);
+      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth_rbo);
+      const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
+      gl.DrawBuffers(1, buffers);
+      gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+      if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        throw RuntimeError("shadow framebuffer incomplete");
+      }
+    };
+    make_target(shadow_array_, &map->fbo, &map->depth_rbo);
+    make_target(static_shadow_array_, &map->static_fbo, &map->static_depth_rbo);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     const int s = static_cast<int>(shadow_maps_.size());
     slot[i] = s;
@@ -607,17 +619,22 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_size_uv"), 4, size_uv.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_texel"), 4, texel.data());
   shadows_dirty_ = true;
+  static_shadows_dirty_ = true;
 }
 
-void Renderer::DrawGeometry(int person_flag_location) {
-  // Near to far: the person, then the scene (rooms last), for early depth
-  // rejection. A location of -1 (the shadow pass) makes Uniform1f a no-op.
+void Renderer::DrawPerson(int person_flag_location) {
+  // A location of -1 (the shadow pass) makes Uniform1f a no-op.
   const GlFunctions& gl = gl_;
   if (person_visible_ && person_index_count_ > 0) {
     gl.Uniform1f(person_flag_location, 1.0f);
     gl.BindVertexArray(person_vao_);
     gl.DrawElements(GL_TRIANGLES, person_index_count_, GL_UNSIGNED_INT, nullptr);
   }
+  gl.BindVertexArray(0);
+}
+
+void Renderer::DrawStatic(int person_flag_location) {
+  const GlFunctions& gl = gl_;
   if (static_index_count_ > 0) {
     gl.Uniform1f(person_flag_location, 0.0f);
     gl.BindVertexArray(static_vao_);
@@ -634,16 +651,35 @@ void Renderer::UpdateShadows() {
   gl.DepthFunc(GL_LESS);
   const float far_value[4] = {1e9f, 0, 0, 0};
   const float one = 1.0f;
-  for (const auto& map : shadow_maps_) {
-    gl.BindFramebuffer(GL_FRAMEBUFFER, map->fbo);
-    gl.Viewport(0, 0, options_.shadow_map_size, options_.shadow_map_size);
-    gl.ClearBufferfv(GL_COLOR, 0, far_value);
-    gl.ClearBufferfv(GL_DEPTH, 0, &one);
+  const int size = options_.shadow_map_size;
+  const auto set_view = [&](const ShadowMap& map) {
     gl.UniformMatrix4fv(gl.GetUniformLocation(shadow_program_, "u_clip_from_world"), 1, GL_FALSE,
-                        map->clip_from_world.data());
+                        map.clip_from_world.data());
     gl.UniformMatrix4fv(gl.GetUniformLocation(shadow_program_, "u_cam_from_world"), 1, GL_FALSE,
-                        map->cam_from_world.data());
-    DrawGeometry(-1);
+                        map.cam_from_world.data());
+  };
+  gl.Viewport(0, 0, size, size);
+  if (static_shadows_dirty_) {
+    for (const auto& map : shadow_maps_) {
+      gl.BindFramebuffer(GL_FRAMEBUFFER, map->static_fbo);
+      gl.ClearBufferfv(GL_COLOR, 0, far_value);
+      gl.ClearBufferfv(GL_DEPTH, 0, &one);
+      set_view(*map);
+      DrawStatic(-1);
+    }
+    static_shadows_dirty_ = false;
+  }
+  // Each frame: the static scene's z and depth copied, then the person drawn
+  // over them (ties between the person's and the scene's 24-bit depth, below
+  // 0.1 mm, keep the scene).
+  for (const auto& map : shadow_maps_) {
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, map->static_fbo);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, map->fbo);
+    gl.BlitFramebuffer(0, 0, size, size, 0, 0, size, size, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT,
+                       GL_NEAREST);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, map->fbo);
+    set_view(*map);
+    DrawPerson(-1);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   shadows_dirty_ = false;
@@ -712,7 +748,11 @@ void Renderer::Draw(int index) {
     gl.BindTexture(GL_TEXTURE_2D_ARRAY, shadow_array_);
     gl.ActiveTexture(GL_TEXTURE0);
   }
-  DrawGeometry(gl.GetUniformLocation(program_, "u_person"));
+  // Near to far: the person, then the scene (rooms last), for early depth
+  // rejection.
+  const int person_flag = gl.GetUniformLocation(program_, "u_person");
+  DrawPerson(person_flag);
+  DrawStatic(person_flag);
 }
 
 void Renderer::Read(int index, CameraImages* out, bool want_depth) {

@@ -97,7 +97,8 @@ class Renderer {
   struct Target;
   struct ShadowMap;
   void UpdateShadows();
-  void DrawGeometry(int person_flag_location);
+  void DrawPerson(int person_flag_location);
+  void DrawStatic(int person_flag_location);
   void Draw(int index);
   void Read(int index, CameraImages* out, bool want_depth);
   GlContext& context_;
@@ -109,6 +110,10 @@ class Renderer {
   unsigned shadow_program_ = 0;
   std::vector<std::unique_ptr<ShadowMap>> shadow_maps_;
   unsigned shadow_array_ = 0;  // GL_TEXTURE_2D_ARRAY, a layer per shadow map
+  // The static scene's layers, drawn once per scene and lighting; each frame
+  // starts from a copy of them and draws the person only.
+  unsigned static_shadow_array_ = 0;
+  bool static_shadows_dirty_ = true;
   unsigned bounce_textures_[6] = {0, 0, 0, 0, 0, 0};  // GL_TEXTURE_3D, one per axis direction
   bool shadows_dirty_ = true;
   unsigned static_vao_ = 0, static_vbo_ = 0, static_ibo_ = 0;
