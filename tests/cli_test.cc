@@ -207,7 +207,10 @@ TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
 }
 
 // Renames nodes in a GLB's JSON chunk (the BIN chunk kept as is).
-void RenameGlbNodes(const fs::path& in, const fs::path& out, const std::map<std::string, std::string>& names) {
+// Renames nodes; the node named `detach` (after renaming), if any, is cut from
+// its parent and made a root of the scene.
+void RenameGlbNodes(const fs::path& in, const fs::path& out, const std::map<std::string, std::string>& names,
+                    const std::string& detach = "") {
   const std::string bytes = ReadText(in);
   uint32_t json_length = 0;
   std::memcpy(&json_length, bytes.data() + 12, 4);
@@ -215,6 +218,15 @@ void RenameGlbNodes(const fs::path& in, const fs::path& out, const std::map<std:
   for (auto& node : json["nodes"]) {
     const auto it = names.find(node.value("name", ""));
     if (it != names.end()) node["name"] = it->second;
+  }
+  for (size_t i = 0; i < json["nodes"].size() && !detach.empty(); ++i) {
+    if (json["nodes"][i].value("name", "") != detach) continue;
+    for (auto& node : json["nodes"]) {
+      if (!node.contains("children")) continue;
+      auto& kids = node["children"];
+      for (auto it = kids.begin(); it != kids.end();) it = *it == i ? kids.erase(it) : std::next(it);
+    }
+    json["scenes"][0]["nodes"].push_back(i);
   }
   std::string text = json.dump();
   while (text.size() % 4) text += ' ';
@@ -244,7 +256,10 @@ TEST(CliTest, RiggedMeshesAreAvatarsAndBadOnesAreRefused) {
   // A corrupt GLB (cut short) and a rig with no right arm chain: one line
   // naming the file and field, exit 2, no sequence left behind.
   WriteText(dir / "cut.glb", ReadText(dir / "p5.glb").substr(0, 400));
-  RenameGlbNodes(dir / "p5.glb", dir / "no_arm.glb", {{"right_shoulder", "bone_a"}, {"right_elbow", "bone_b"}});
+  // (Renamed joints alone map by the hierarchy's shape; cut from the chest,
+  // the arm is no part of the body.)
+  RenameGlbNodes(dir / "p5.glb", dir / "no_arm.glb",
+                 {{"right_clavicle", "bone_c"}, {"right_shoulder", "bone_a"}, {"right_elbow", "bone_b"}}, "bone_c");
   for (const auto& [file, expected] : {std::pair<std::string, std::string>{"cut.glb", "cut.glb: file: "},
                                        {"no_arm.glb", "no_arm.glb: skin: no arm chain"}}) {
     for (const auto& args :

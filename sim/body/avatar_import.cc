@@ -12,6 +12,7 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "sim/body/internal/joint_naming.h"
+#include "sim/body/internal/joint_topology.h"
 #include "sim/body/internal/imported_rig.h"
 
 // How an import works (ImportRiggedAvatar):
@@ -162,6 +163,15 @@ std::array<int, kJointCount> RigJointOf(const JointMapping& mapping, const Rig& 
     }
   }
   return rig_of;
+}
+
+// Whether every arm, torso and leg joint is mapped.
+bool HasEveryChain(const std::array<int, kJointCount>& rig_of) {
+  for (int j : {kPelvis, kNeck, kHead, kRightShoulder, kRightElbow, kRightWrist, kLeftShoulder, kLeftElbow,
+                kLeftWrist, kRightHip, kRightKnee, kRightAnkle, kLeftHip, kLeftKnee, kLeftAnkle}) {
+    if (rig_of[j] < 0) return false;
+  }
+  return true;
 }
 
 // Throws InputError(file, "skin") when an arm, torso or leg joint is unmapped.
@@ -343,10 +353,14 @@ void SwapSides(std::array<int, kJointCount>& rig_of,
                Weights& weights,
                JointMapping& mapping,
                const std::string& file) {
-  Log().warn(
-      "avatar import: {}: the feet point backwards: the rig's left/right joint names are the "
-      "character's right/left; swapping them",
-      file);
+  if (mapping.convention == "hierarchy") {  // the sides were a guess
+    Log().debug("avatar import: {}: the feet tell the character's left from right", file);
+  } else {
+    Log().warn(
+        "avatar import: {}: the feet point backwards: the rig's left/right joint names are the "
+        "character's right/left; swapping them",
+        file);
+  }
   const size_t n = weights.bone_index.size();
   std::vector<std::array<uint8_t, 4>>& bone_index = weights.bone_index;
   std::array<int, kJointCount> swapped;
@@ -725,6 +739,17 @@ Avatar BuildAvatar(const Rig& rig, const fs::path& path, const ImportOptions& op
 
   JointMapping mapping = MapJoints(rig.joint_name, options.joint_map, file);
   std::array<int, kJointCount> rig_of = RigJointOf(mapping, rig);
+  if (options.joint_map.empty() && !HasEveryChain(rig_of)) {
+    // No table names every chain: the hierarchy's shape maps the rig.
+    try {
+      mapping = MapJointsByHierarchy(rig, file);
+    } catch (const InputError& e) {
+      throw InputError(file, e.field(),
+                       e.message() + " (no name table maps every chain either, best '" + mapping.convention +
+                           "'; rig joints: " + JoinNames(rig.joint_name) + "; pass a joint map)");
+    }
+    rig_of = RigJointOf(mapping, rig);
+  }
   CheckChains(rig_of, rig, mapping, file);
   const std::vector<int> collapsed = CollapsedJoints(rig, rig_of);
   // Collapsed weights (before any side swap).

@@ -66,7 +66,10 @@ std::string AvatarInfoText(const std::string& name_or_path) {
   if (a.params.source.is_object()) {
     const nlohmann::json& src = a.params.source;
     out << "imported    " << src["file"].get<std::string>() << "\n"
-        << "rig         " << src["convention"].get<std::string>() << " names, up " << src["up_axis"].get<std::string>()
+        << "rig         "
+        << (src["convention"] == "hierarchy" ? std::string("mapped by its hierarchy (no name table knows its joints)")
+                                             : src["convention"].get<std::string>() + " names")
+        << ", up " << src["up_axis"].get<std::string>()
         << ", " << src["scale"].get<double>() << " m per file unit\n"
         << "joint map   (canonical <- rig)\n";
     for (int j = 0; j < kJointCount; ++j) {
