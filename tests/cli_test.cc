@@ -7,8 +7,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <Eigen/Core>
+
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -191,6 +195,31 @@ TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
   const Result info = RunIrbench({"avatar", "info", "p2"}, dir);
   EXPECT_EQ(info.exit_code, 0);
   EXPECT_NE(info.out.find("watertight  yes"), std::string::npos) << info.out;
+  // The arm lengths it prints are the rendered truth's bone lengths (which
+  // no motion changes) and the bind pose's shoulder width.
+  double width = 0, upper_r = 0, upper_l = 0, fore_r = 0, fore_l = 0;
+  const size_t arms = info.out.find("arms        ");
+  ASSERT_NE(arms, std::string::npos) << info.out;
+  ASSERT_EQ(std::sscanf(info.out.c_str() + arms, "arms        shoulder width %lf m; upper arm %lf / %lf m, forearm %lf / %lf m",
+                        &width, &upper_r, &upper_l, &fore_r, &fore_l), 5)
+      << info.out;
+  const Result seq = RunIrbench({"render", "--avatar", "p2", "--motion", "wave", "--frames", "3", "--background-frames",
+                                 "0", "--out", (dir / "arms").string()},
+                                dir);
+  ASSERT_EQ(seq.exit_code, 0) << seq.err;
+  std::ifstream truth(dir / "arms" / "truth" / "frames.jsonl");
+  std::string line;
+  for (int frame = 0; std::getline(truth, line); ++frame) {
+    const auto j = nlohmann::json::parse(line)["joints3d"];
+    const auto at = [&](const char* name) {
+      return Eigen::Vector3d(j[name][0].get<double>(), j[name][1].get<double>(), j[name][2].get<double>());
+    };
+    EXPECT_NEAR((at("right_elbow") - at("right_shoulder")).norm(), upper_r, 1e-3) << frame;
+    EXPECT_NEAR((at("left_elbow") - at("left_shoulder")).norm(), upper_l, 1e-3) << frame;
+    EXPECT_NEAR((at("right_wrist") - at("right_elbow")).norm(), fore_r, 1e-3) << frame;
+    EXPECT_NEAR((at("left_wrist") - at("left_elbow")).norm(), fore_l, 1e-3) << frame;
+    if (frame == 0) EXPECT_NEAR((at("right_shoulder") - at("left_shoulder")).norm(), width, 0.02);
+  }
   // A height outside 1.0-2.3 m: one line naming the file and field, exit 2.
   WriteText(dir / "tall.json", R"({"format": "irbench.avatar/1", "kind": "parametric", "height_m": 2.6})");
   for (const auto& args : {std::vector<std::string>{"avatar", "export", (dir / "tall.json").string(),
@@ -206,8 +235,7 @@ TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
   EXPECT_FALSE(fs::exists(dir / "seq"));
 }
 
-// Renames nodes in a GLB's JSON chunk (the BIN chunk kept as is).
-// Renames nodes; the node named `detach` (after renaming), if any, is cut from
+// Renames nodes in a GLB's JSON chunk (the BIN chunk kept as is); the node named `detach` (after renaming), if any, is cut from
 // its parent and made a root of the scene.
 void RenameGlbNodes(const fs::path& in, const fs::path& out, const std::map<std::string, std::string>& names,
                     const std::string& detach = "") {

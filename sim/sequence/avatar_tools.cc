@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <iomanip>
 #include <sstream>
 
 #include "common/error.h"
@@ -63,6 +64,15 @@ std::string AvatarInfoText(const std::string& name_or_path) {
       << "watertight  " << (open == 0 ? "yes" : "no: " + std::to_string(open) + " edges not shared by two faces")
       << "\n"
       << "joints      " << kJointCount << " (canonical skeleton)\n";
+  // The figures a tracker's per-user model configuration estimates (thesis
+  // 6.1.1): joint centre to joint centre, at the bind pose.
+  const auto& b = a.skeleton.bind_position;
+  const auto length = [&](int from, int to) { return (b[to] - b[from]).norm(); };
+  out << std::fixed << std::setprecision(3) << "arms        shoulder width " << length(kLeftShoulder, kRightShoulder)
+      << " m; upper arm " << length(kRightShoulder, kRightElbow) << " / " << length(kLeftShoulder, kLeftElbow)
+      << " m, forearm " << length(kRightElbow, kRightWrist) << " / " << length(kLeftElbow, kLeftWrist)
+      << " m (right / left, joint centres)\n"
+      << std::defaultfloat << std::setprecision(6);
   if (a.params.source.is_object()) {
     const nlohmann::json& src = a.params.source;
     out << "imported    " << src["file"].get<std::string>() << "\n"
