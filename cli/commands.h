@@ -41,6 +41,8 @@ std::vector<Command> AddAvatarCommand(CLI::App& app);
 std::vector<Command> AddTrainCommand(CLI::App& app);
 // Adds `fault`: a copy of a sequence with camera faults put in.
 std::vector<Command> AddFaultCommand(CLI::App& app);
+// Adds `export coco|easymocap`: a sequence as a dataset.
+std::vector<Command> AddExportCommand(CLI::App& app);
 // Adds `bench render|track`: throughput figures.
 std::vector<Command> AddBenchCommand(CLI::App& app);
 

@@ -31,7 +31,8 @@ std::vector<Command> AddCommands(CLI::App& app) {
                            irbench::cli::AddDemoCommand, irbench::cli::AddSuiteCommand,
                            irbench::cli::AddScoreCommand, irbench::cli::AddMotionCommand,
                            irbench::cli::AddAvatarCommand, irbench::cli::AddTrainCommand,
-                           irbench::cli::AddFaultCommand, irbench::cli::AddBenchCommand}) {
+                           irbench::cli::AddFaultCommand, irbench::cli::AddExportCommand,
+                           irbench::cli::AddBenchCommand}) {
     for (Command& command : add(app)) commands.push_back(std::move(command));
   }
   return commands;

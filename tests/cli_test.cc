@@ -64,6 +64,7 @@ TEST(CliTest, HelpOnEveryCommand) {
         {"bench", "render", "--help"}, {"motion", "--help"}, {"motion", "list", "--help"},
         {"motion", "info", "--help"}, {"motion", "export", "--help"}, {"avatar", "--help"},
         {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
+        {"export", "--help"},
         {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}, {"suite", "run", "--help"},
         {"fault", "--help"}, {"train", "rest", "--help"}}) {
     const Result r = RunIrbench(args, dir);
