@@ -219,7 +219,9 @@ TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
     EXPECT_NEAR((at("left_elbow") - at("left_shoulder")).norm(), upper_l, 1e-3) << frame;
     EXPECT_NEAR((at("right_wrist") - at("right_elbow")).norm(), fore_r, 1e-3) << frame;
     EXPECT_NEAR((at("left_wrist") - at("left_elbow")).norm(), fore_l, 1e-3) << frame;
-    if (frame == 0) EXPECT_NEAR((at("right_shoulder") - at("left_shoulder")).norm(), width, 0.02);
+    if (frame == 0) {
+      EXPECT_NEAR((at("right_shoulder") - at("left_shoulder")).norm(), width, 0.02);
+    }
   }
   // A height outside 1.0-2.3 m: one line naming the file and field, exit 2.
   WriteText(dir / "tall.json", R"({"format": "irbench.avatar/1", "kind": "parametric", "height_m": 2.6})");
