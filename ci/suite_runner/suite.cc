@@ -18,6 +18,7 @@
 #include "common/error.h"
 #include "common/json_reader.h"
 #include "common/logging.h"
+#include "common/progress.h"
 #include "common/paths.h"
 #include "sequence_format/manifest.h"
 #include "sim/sequence/render_job.h"
@@ -259,11 +260,20 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   std::vector<fs::path> reports(scenarios.size());
   std::atomic<size_t> next{0};
   std::mutex render_mutex;
+  // One progress line for the suite; the scenarios' renders and tracks run
+  // on several threads and keep theirs quiet.
+  const QuietProgress quiet;
+  Progress progress("suite " + result.name, "scenarios", static_cast<int>(scenarios.size()));
+  progress.IgnoreQuiet();
+  std::mutex progress_mutex;
+  int finished = 0;
   const auto work = [&] {
     for (size_t i; (i = next++) < scenarios.size();) {
       try {
-        Log().info("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), scenarios[i].name);
+        Log().debug("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), scenarios[i].name);
         measured[i] = RunScenario(scenarios[i], result.name, cache, &render_mutex, &reports[i]);
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        progress.Set(++finished, "scenarios done");
       } catch (...) {
         errors[i] = std::current_exception();
         next = scenarios.size();  // start no more

@@ -4,11 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <memory>
 
 #include "common/atomic_file.h"
 #include "common/cancel.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "common/progress.h"
 #include "common/paths.h"
 #include "sequence_format/calibration.h"
 #include "sequence_format/manifest.h"
@@ -255,22 +257,21 @@ nlohmann::json BuildManifest(const RenderJobOptions& options,
   return manifest;
 }
 
-// The render's progress in frame-sets, logged at most once a second and at
-// each phase's last frame-set.
+// The render's progress in frame-sets, per phase (background, frame):
+// common/progress.h, a line rewritten in place on a terminal, a log line
+// every few seconds otherwise.
 class RenderProgress {
  public:
-  RenderProgress() : start_(std::chrono::steady_clock::now()), last_report_(start_) {}
+  RenderProgress() : start_(std::chrono::steady_clock::now()) {}
 
-  // Counts one frame-set done, then logs frame-set `index` of `count` of
-  // `phase` when due.
+  // Counts frame-set `index` of `count` of `phase` done.
   void FrameSetDone(const char* phase, int index, int count) {
-    ++done_;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_report_ < std::chrono::seconds(1) && index + 1 < count) return;
-    last_report_ = now;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    Log().info("render: {} {}/{} ({:.1f} frame-sets/s)", phase, index + 1, count,
-               elapsed > 0 ? done_ / elapsed : 0.0);
+    if (!phase_ || phase_name_ != phase) {
+      phase_.reset();  // ends the previous phase's line first
+      phase_ = std::make_unique<Progress>("render", "frame-sets", count);
+      phase_name_ = phase;
+    }
+    phase_->Set(index + 1, phase);
   }
 
   // Seconds since the progress began.
@@ -280,8 +281,8 @@ class RenderProgress {
 
  private:
   std::chrono::steady_clock::time_point start_;
-  std::chrono::steady_clock::time_point last_report_;
-  int done_ = 0;
+  std::unique_ptr<Progress> phase_;
+  std::string phase_name_;
 };
 
 // Motion blur: sub-frame renders over the exposure, averaged.

@@ -13,6 +13,7 @@
 #include "common/cancel.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "common/progress.h"
 #include "tracker/frontend/camera_health.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/hull/ply.h"
@@ -401,14 +402,12 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  auto last_report = start;
-  for (int f = 0; f < frames; ++f) {
-    ThrowIfCancelled();
-    TrackFrame(f, run);
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_report > std::chrono::seconds(2)) {
-      Log().info("track: frame {}/{}", f + 1, frames);
-      last_report = now;
+  {
+    Progress progress("track", "frame-sets", frames);
+    for (int f = 0; f < frames; ++f) {
+      ThrowIfCancelled();
+      TrackFrame(f, run);
+      progress.Set(f + 1, "frame");
     }
   }
   AtomicWriteFile(root / "features.jsonl", run.lines);
