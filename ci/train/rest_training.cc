@@ -2,6 +2,7 @@
 
 #include "common/error.h"
 #include "common/logging.h"
+#include "common/progress.h"
 #include "common/paths.h"
 #include "sim/body/avatar.h"
 #include "sim/motion/labels.h"
@@ -24,6 +25,9 @@ RestTrainingResult RunRestTraining(const RestTrainingOptions& options) {
   };
   std::vector<std::array<float, 6>> features;
   std::vector<int> labels;
+  Progress progress("train rest", "motions",
+                    static_cast<int>(options.avatars.size() * options.motions.size()));
+  int sampled = 0;
   for (const std::string& avatar_name : options.avatars) {
     const std::filesystem::path avatar_file = ResolveDataFile("avatars", avatar_name, "--avatars");
     const Avatar avatar = LoadAvatar(avatar_file);
@@ -48,7 +52,8 @@ RestTrainingResult RunRestTraining(const RestTrainingOptions& options) {
           labels.push_back(rest[side].get<bool>() ? 1 : 0);
         }
       }
-      Log().info("train rest: {} on {}: {} samples so far", motion_name, avatar_name, features.size());
+      Log().debug("train rest: {} on {}: {} samples so far", motion_name, avatar_name, features.size());
+      progress.Set(++sampled, "motions sampled");
     }
   }
   RestTrainingResult result;
