@@ -13,6 +13,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev libtinygltf-dev
+  libssl-dev    # SHA-256 of the model files a track used (common/sha256.h)
   gnuplot-nox   # the report's plots (irbench score)
   chromium      # the report's test opens it in headless Chromium
   python3       # ci/checks/code_shape.py (a CTest test): function and file sizes, layering

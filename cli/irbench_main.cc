@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
                "runs the tracker on them (track) and scores track files against the truth (score).",
                "irbench"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", irbench::ToolVersion());
+  app.set_version_flag("--version", "irbench " + irbench::ToolVersion() + "\ndata root: " + irbench::DataRoot().string());
   int verbosity = 1;
   app.add_flag_callback("-q,--quiet", [&] { verbosity = 0; }, "only warnings and errors on stderr");
   app.add_flag_callback("-v,--verbose", [&] { verbosity = 2; }, "debug messages on stderr");

@@ -9,11 +9,26 @@
 namespace irbench {
 namespace fs = std::filesystem;
 
+fs::path InstalledDataRoot() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const fs::path share = (exe.parent_path() / ".." / "share" / "irbench").lexically_normal();
+  return fs::is_directory(share / "scenes", ec) ? share : fs::path();
+}
+
 fs::path DataRoot() {
   if (const char* env = std::getenv("IRBENCH_DATA_DIR"); env != nullptr && *env != '\0') {
     return fs::path(env);
   }
+  if (fs::path installed = InstalledDataRoot(); !installed.empty()) return installed;
   return fs::path(IRBENCH_SOURCE_DIR);
+}
+
+fs::path OutputRoot() {
+  const char* env = std::getenv("IRBENCH_DATA_DIR");
+  if ((env == nullptr || *env == '\0') && !InstalledDataRoot().empty()) return fs::current_path();
+  return DataRoot();
 }
 
 fs::path ResolveDataFile(const std::string& kind,

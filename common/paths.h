@@ -7,9 +7,20 @@
 
 namespace irbench {
 
-// The folder that holds scenes/, rigs/, avatars/, motions/: $IRBENCH_DATA_DIR if
-// set, else the source tree this binary was built from.
+// The folder that holds scenes/, rigs/, avatars/, motions/ (and ci/suites/,
+// ci/baselines/, tracker/models/): $IRBENCH_DATA_DIR if set; else, for an
+// installed program, <prefix>/share/irbench beside its bin/ (cmake --install,
+// the .deb); else the source tree this binary was built from.
 std::filesystem::path DataRoot();
+
+// Where default outputs go (renders/<name>, renders/demo, renders/cache): the
+// data root, unless that is an installed, shared folder; then the current
+// folder.
+std::filesystem::path OutputRoot();
+
+// <exe>/../share/irbench when it holds scenes/ (an installed program); empty
+// otherwise.
+std::filesystem::path InstalledDataRoot();
 
 // `kind` is a folder name ("scenes"); `name_or_path` is a name or a file path.
 // Throws InputError naming `option` and the names available when nothing matches.

@@ -188,6 +188,41 @@ TEST(CliTest, BadMotionFilesNameTheLine) {
   EXPECT_NE(r.err.find("point_horizontal"), std::string::npos) << r.err;  // lists the library
 }
 
+// Issue 33.4: `cmake --install` puts the program, its OSMesa module and its
+// data under a prefix; the installed program runs from any folder, reads its
+// data from <prefix>/share/irbench (not the source tree) and writes default
+// outputs under the current folder.
+TEST(CliTest, InstalledProgramRunsFromAnywhereWithItsData) {
+  const fs::path dir = FreshTempDir("cli_install");
+  const fs::path prefix = dir / "prefix";
+  const std::string install = "cmake --install '" + std::string(IRBENCH_BINARY_DIR) + "' --prefix '" +
+                              prefix.string() + "' > '" + (dir / "install.log").string() + "' 2>&1";
+  ASSERT_EQ(std::system(install.c_str()), 0) << ReadText(dir / "install.log");
+  for (const char* file : {"bin/irbench", "lib/irbench/libirbench_osmesa.so", "share/irbench/scenes/theater.json",
+                           "share/irbench/rigs/theater4.json", "share/irbench/avatars/p1.json",
+                           "share/irbench/ci/suites/smoke.json", "share/irbench/tracker/models/rest_svm.yml"}) {
+    EXPECT_TRUE(fs::exists(prefix / file)) << file;
+  }
+  const fs::path work = dir / "work";  // no renders/ yet: the default output makes it
+  fs::create_directories(work);
+  const auto run = [&](const std::string& args) {
+    const std::string command = "cd '" + work.string() + "' && env -u IRBENCH_DATA_DIR '" +
+                                (prefix / "bin" / "irbench").string() + "' " + args + " > '" +
+                                (dir / "out.txt").string() + "' 2> '" + (dir / "err.txt").string() + "'";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  ASSERT_EQ(run("--version"), 0) << ReadText(dir / "err.txt");
+  EXPECT_NE(ReadText(dir / "out.txt").find("data root: " + (prefix / "share" / "irbench").string()), std::string::npos)
+      << ReadText(dir / "out.txt");
+  // A render by names alone, into ./renders/ (the default output).
+  ASSERT_EQ(run("render --rig lab4 --avatar p2 --motion wave --frames 1 --background-frames 0 --supersample 1 "
+                "--backend osmesa"),
+            0)
+      << ReadText(dir / "err.txt");
+  EXPECT_TRUE(fs::exists(work / "renders" / "lab4-p2-wave-s1" / "manifest.json")) << ReadText(dir / "out.txt");
+}
+
 TEST(CliTest, AvatarExportWritesGlbAndBadAvatarsAreRefused) {
   const fs::path dir = FreshTempDir("cli_avatar");
   const Result r = RunIrbench({"avatar", "export", "p2", (dir / "p2.glb").string()}, dir);
@@ -555,6 +590,12 @@ TEST(CliTest, DemoRendersTracksAndScores) {
   const auto score = nlohmann::json::parse(ReadText(dir / "demo" / "score" / "score.json"));
   EXPECT_TRUE(score["joints_cm"]["neck"]["mean"].is_null()) << score["joints_cm"]["neck"].dump();
   EXPECT_EQ(score["joints_cm"]["neck"]["total"], 0);
+  // track.json names the model file the track used by content: the shipped
+  // rest-state model's SHA-256 as coreutils' sha256sum gives it.
+  const auto track = nlohmann::json::parse(ReadText(dir / "demo" / "track" / "track.json"));
+  const std::string model = track["models"]["rest_state"]["file"];
+  ASSERT_EQ(std::system(("sha256sum '" + model + "' > '" + (dir / "sha.txt").string() + "'").c_str()), 0);
+  EXPECT_EQ(ReadText(dir / "sha.txt").substr(0, 64), track["models"]["rest_state"]["sha256"]) << track.dump();
   // Again without --force: refused, the first run kept.
   const Result again = RunIrbench({"demo", "--frames", "8", "--out", (dir / "demo").string()}, dir);
   EXPECT_EQ(again.exit_code, 2);

@@ -18,7 +18,8 @@ DemoResult RunDemo(const DemoOptions& options) {
   render.frames = options.frames;
   render.seed = options.seed;
   render.background_frames = 12;
-  render.out = options.out.empty() ? DataRoot() / "renders" / "demo" : options.out;
+  render.out = options.out.empty() ? OutputRoot() / "renders" / "demo" : options.out;
+  if (options.out.empty()) std::filesystem::create_directories(render.out.parent_path());
   render.overwrite = options.overwrite;
   Log().info("demo: 1/3 render ({} on theater4, {} preset)", options.avatar, options.sensor);
   DemoResult result;

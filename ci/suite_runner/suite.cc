@@ -242,7 +242,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   const fs::path baseline_file = baselines_dir / (result.name + ".json");
   nlohmann::json baseline = nlohmann::json::object();
   if (fs::is_regular_file(baseline_file)) baseline = ParseJsonFile(baseline_file.string()).raw();
-  const fs::path cache = options.cache.empty() ? DataRoot() / "renders" / "cache" : options.cache;
+  const fs::path cache = options.cache.empty() ? OutputRoot() / "renders" / "cache" : options.cache;
   // The cache holds what the suite writes; it may not hold or lie in what it
   // reads (the suite file, the baselines, the scenarios' data files).
   std::vector<fs::path> inputs = {file, baselines_dir};

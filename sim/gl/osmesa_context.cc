@@ -24,7 +24,11 @@ std::vector<std::string> ModuleCandidates() {
   }
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back((exe.parent_path() / "libirbench_osmesa.so").string());
+  if (!ec) {
+    candidates.push_back((exe.parent_path() / "libirbench_osmesa.so").string());
+    // Installed: <prefix>/bin/irbench and <prefix>/lib/irbench/.
+    candidates.push_back((exe.parent_path() / ".." / "lib" / "irbench" / "libirbench_osmesa.so").string());
+  }
   candidates.push_back(IRBENCH_OSMESA_MODULE_PATH);
   return candidates;
 }

@@ -164,9 +164,10 @@ std::vector<fs::path> RenderInputFiles(const RenderInputs& in) {
 fs::path OutputFolder(const RenderJobOptions& options, const RenderInputs& in) {
   fs::path out = options.out;
   if (out.empty()) {
-    out = DataRoot() / "renders" /
+    out = OutputRoot() / "renders" /
           (in.rig.name + "-" + in.avatar.params.name + "-" + in.motion_name + "-s" +
            std::to_string(options.seed));
+    fs::create_directories(out.parent_path());  // the default's own folder
   }
   CheckOutputApart(out, RenderInputFiles(in), "--out");
   CheckOutputReplaceable(out, options.overwrite, "--out");

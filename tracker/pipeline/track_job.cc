@@ -14,6 +14,7 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "common/progress.h"
+#include "common/sha256.h"
 #include "tracker/frontend/camera_health.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/hull/ply.h"
@@ -427,6 +428,15 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                nlohmann::json(run.left_out_counts[c]).dump());
   }
   meta["cameras_left_out"] = left_out;
+  // The model files this track used, by content (what they are is in each
+  // file's own header: how it was made).
+  nlohmann::json models = nlohmann::json::object();
+  if (rest_classifier) {
+    const fs::path rest_path = settings.rest_model.empty() ? DefaultRestModelPath() : settings.rest_model;
+    models["rest_state"] = {{"file", fs::absolute(rest_path).lexically_normal().string()},
+                            {"sha256", Sha256OfFile(rest_path)}};
+  }
+  meta["models"] = models;
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Log().info("track: {} frame-sets in {:.1f} s ({:.1f} ms per frame-set incl. I/O)", frames, seconds,
