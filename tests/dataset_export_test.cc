@@ -171,7 +171,6 @@ TEST_F(DatasetExportTest, EasyMocapReadsBackThroughOpenCvWithTheSameCameras) {
   options.format = DatasetFormat::kEasyMocap;
   const fs::path out = RunDatasetExport(options);
   const std::vector<json> truth = ReadLines(*seq_ / "truth/frames.jsonl");
-  const json cameras = ReadJson(*seq_ / "calib/cameras.json");
 
   cv::FileStorage intri((out / "intri.yml").string(), cv::FileStorage::READ);
   cv::FileStorage extri((out / "extri.yml").string(), cv::FileStorage::READ);

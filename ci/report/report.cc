@@ -13,6 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/logging.h"
+#include "sequence_format/frame_lines.h"
 #include "sequence_format/manifest.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/body_model/body_model.h"

@@ -45,11 +45,6 @@ struct ScoreOptions {
   bool include_rest_arms = false;  // score elbows and wrists of arms at rest too
 };
 
-// A frames.jsonl or track.jsonl file by frame index. Throws InputError naming
-// the file and line for a line that is not JSON, lacks an integer `frame`, or
-// repeats one.
-std::map<int, nlohmann::json> ReadFrameLines(const std::filesystem::path& path);
-
 // "right_elbow" -> "Right Elbow": names as the tables print them.
 std::string TitleCase(const std::string& name);
 

@@ -5,6 +5,7 @@
 
 #include "ci/report/report.h"
 #include "ci/score/score.h"
+#include "sequence_format/frame_lines.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/logging.h"

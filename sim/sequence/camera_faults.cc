@@ -10,6 +10,7 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "sequence_format/calibration.h"
+#include "sim/sequence/render_resume.h"  // FrameFileName
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -39,11 +40,6 @@ double ParseSeconds(const std::string& text, const std::string& whole, const std
   return v;
 }
 
-std::string FrameName(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "%06d.png", frame);
-  return name;
-}
 
 // Copies the sequence tree: hard links where the file system allows (the
 // faults replace files by rename, never write through a link), else copies.
@@ -90,7 +86,7 @@ int ApplyFault(const CameraFault& fault, const fs::path& root, double fps, int f
   cv::Mat frozen;
   int touched = 0;
   for (int f = first; f < end; ++f) {
-    const fs::path path = folder / FrameName(f);
+    const fs::path path = folder / FrameFileName(f, "png");
     if (!fs::exists(path)) continue;  // already dropped
     ++touched;
     switch (fault.kind) {
@@ -155,7 +151,7 @@ fs::path RunFaultJob(const FaultJobOptions& options) {
   const double fps = calibration.timing.empty() ? 30.0 : calibration.timing.front().fps;
   // The sequence's length: camera 0's frames.
   int frame_count = 0;
-  while (fs::exists(options.sequence / "frames" / calibration.cameras.front().name / FrameName(frame_count))) {
+  while (fs::exists(options.sequence / "frames" / calibration.cameras.front().name / FrameFileName(frame_count, "png"))) {
     ++frame_count;
   }
   for (const CameraFault& fault : options.faults) {

@@ -1,7 +1,5 @@
 #include "sim/sequence/dataset_export.h"
 
-#include <cstdio>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -12,43 +10,15 @@
 #include "common/error.h"
 #include "common/logging.h"
 #include "sequence_format/calibration.h"
+#include "sequence_format/frame_lines.h"
 #include "sequence_format/manifest.h"
+#include "sim/sequence/render_resume.h"  // FrameFileName
 
 namespace irbench {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-std::string FrameName(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "%06d.png", frame);
-  return name;
-}
-
-std::string JsonName(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "%06d.json", frame);
-  return name;
-}
-
-// The truth's lines by frame. Throws InputError naming the file and line.
-std::map<int, json> ReadTruth(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "file", "cannot be read (not a rendered sequence?)");
-  std::map<int, json> lines;
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    json j = json::parse(line, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("frame") || !j["frame"].is_number_integer()) {
-      throw InputError(file.string(), "line " + std::to_string(number), "not a truth frame (JSON with \"frame\")");
-    }
-    const int frame = j["frame"].get<int>();
-    lines[frame] = std::move(j);
-  }
-  return lines;
-}
 
 // The frame's image, linked (or copied) into `to`. Throws InputError when missing.
 void LinkImage(const fs::path& from, const fs::path& to) {
@@ -86,14 +56,9 @@ json Rle(const cv::Mat& mask) {
   return {{"counts", counts}, {"size", {mask.rows, mask.cols}}};
 }
 
-// [u, v, visibility] of a truth joint in one camera; nullopt when absent.
-std::optional<std::array<double, 3>> Joint2d(const json& camera_joints, const std::string& joint) {
-  const auto it = camera_joints.find(joint);
-  if (it == camera_joints.end() || !it->is_array() || it->size() != 3) return std::nullopt;
-  return std::array<double, 3>{(*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>()};
-}
-
-std::optional<std::array<double, 3>> Joint3d(const json& joints, const std::string& joint) {
+// The three numbers of a truth joint: [u, v, visibility] in a camera's
+// joints2d, [x, y, z] in joints3d; nullopt when absent.
+std::optional<std::array<double, 3>> JointEntry(const json& joints, const std::string& joint) {
   const auto it = joints.find(joint);
   if (it == joints.end() || !it->is_array() || it->size() != 3) return std::nullopt;
   return std::array<double, 3>{(*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>()};
@@ -101,15 +66,15 @@ std::optional<std::array<double, 3>> Joint3d(const json& joints, const std::stri
 
 // BODY_25's mid hip: the mean of the two hips, seen only when both are.
 std::optional<std::array<double, 3>> Body25Joint2d(const json& camera_joints, const std::string& joint) {
-  if (joint != "mid_hip") return Joint2d(camera_joints, joint);
-  const auto l = Joint2d(camera_joints, "left_hip"), r = Joint2d(camera_joints, "right_hip");
+  if (joint != "mid_hip") return JointEntry(camera_joints, joint);
+  const auto l = JointEntry(camera_joints, "left_hip"), r = JointEntry(camera_joints, "right_hip");
   if (!l || !r) return std::nullopt;
   return std::array<double, 3>{0.5 * ((*l)[0] + (*r)[0]), 0.5 * ((*l)[1] + (*r)[1]), std::min((*l)[2], (*r)[2])};
 }
 
 std::optional<std::array<double, 3>> Body25Joint3d(const json& joints, const std::string& joint) {
-  if (joint != "mid_hip") return Joint3d(joints, joint);
-  const auto l = Joint3d(joints, "left_hip"), r = Joint3d(joints, "right_hip");
+  if (joint != "mid_hip") return JointEntry(joints, joint);
+  const auto l = JointEntry(joints, "left_hip"), r = JointEntry(joints, "right_hip");
   if (!l || !r) return std::nullopt;
   return std::array<double, 3>{0.5 * ((*l)[0] + (*r)[0]), 0.5 * ((*l)[1] + (*r)[1]), 0.5 * ((*l)[2] + (*r)[2])};
 }
@@ -118,6 +83,15 @@ struct Source {
   Calibration calibration;
   Manifest manifest;
   std::map<int, json> truth;
+
+  // Frame `f`'s truth line; InputError when the truth lacks it.
+  const json& TruthLine(const fs::path& seq, int f) const {
+    const auto line = truth.find(f);
+    if (line == truth.end()) {
+      throw InputError((seq / "truth/frames.jsonl").string(), "frame " + std::to_string(f), "missing");
+    }
+    return line->second;
+  }
 };
 
 void ExportCoco(const Source& src, const fs::path& seq, const fs::path& out) {
@@ -128,7 +102,7 @@ void ExportCoco(const Source& src, const fs::path& seq, const fs::path& out) {
     fs::create_directories(out / "images" / cam.name);
     for (int f = 0; f < src.manifest.frame_count; ++f) {
       ThrowIfCancelled();
-      const std::string name = FrameName(f);
+      const std::string name = FrameFileName(f, "png");
       LinkImage(seq / "frames" / cam.name / name, out / "images" / cam.name / name);
       ++image_id;
       images.push_back({{"id", image_id},
@@ -137,19 +111,16 @@ void ExportCoco(const Source& src, const fs::path& seq, const fs::path& out) {
                         {"height", cam.height},
                         {"irbench_camera", cam.name},
                         {"irbench_frame", f}});
-      const auto line = src.truth.find(f);
-      if (line == src.truth.end()) {
-        throw InputError((seq / "truth/frames.jsonl").string(), "frame " + std::to_string(f), "missing");
-      }
+      const json& line = src.TruthLine(seq, f);
       const cv::Mat mask = ReadMask(seq / "truth" / "masks" / cam.name / name);
       const int area = cv::countNonZero(mask);
       if (area == 0) continue;  // the person is not in this view
       const cv::Rect box = cv::boundingRect(mask);
-      const json& camera_joints = line->second["joints2d"][cam.name];
+      const json& camera_joints = line["joints2d"][cam.name];
       json keypoints = json::array();
       int labelled = 0;
       for (const auto& [coco, ours] : CocoKeypoints()) {
-        const auto p = ours.empty() ? std::nullopt : Joint2d(camera_joints, ours);
+        const auto p = ours.empty() ? std::nullopt : JointEntry(camera_joints, ours);
         const int v = p ? static_cast<int>((*p)[2]) : 0;
         if (v > 0) {
           keypoints.push_back((*p)[0]), keypoints.push_back((*p)[1]), keypoints.push_back(v);
@@ -202,18 +173,15 @@ void ExportEasyMocap(const Source& src, const fs::path& seq, const fs::path& out
   }
   for (int f = 0; f < src.manifest.frame_count; ++f) {
     ThrowIfCancelled();
-    const auto line = src.truth.find(f);
-    if (line == src.truth.end()) {
-      throw InputError((seq / "truth/frames.jsonl").string(), "frame " + std::to_string(f), "missing");
-    }
-    const std::string name = FrameName(f);
+    const json& line = src.TruthLine(seq, f);
+    const std::string name = FrameFileName(f, "png");
     for (const Camera& cam : src.calibration.cameras) {
       LinkImage(seq / "frames" / cam.name / name, out / "images" / cam.name / name);
       const cv::Mat mask = ReadMask(seq / "truth" / "masks" / cam.name / name);
       json people = json::array();
       if (cv::countNonZero(mask) > 0) {
         const cv::Rect box = cv::boundingRect(mask);
-        const json& camera_joints = line->second["joints2d"][cam.name];
+        const json& camera_joints = line["joints2d"][cam.name];
         json keypoints = json::array();
         for (const auto& [body25, ours] : Body25Keypoints()) {
           const auto p = ours.empty() ? std::nullopt : Body25Joint2d(camera_joints, ours);
@@ -234,15 +202,15 @@ void ExportEasyMocap(const Source& src, const fs::path& seq, const fs::path& out
                           {"width", cam.width},
                           {"annots", people},
                           {"isKeyframe", false}};
-      AtomicWriteFile(out / "annots" / cam.name / JsonName(f), annot.dump() + "\n");
+      AtomicWriteFile(out / "annots" / cam.name / FrameFileName(f, "json"), annot.dump() + "\n");
     }
     json keypoints = json::array();
     for (const auto& [body25, ours] : Body25Keypoints()) {
-      const auto p = ours.empty() ? std::nullopt : Body25Joint3d(line->second["joints3d"], ours);
+      const auto p = ours.empty() ? std::nullopt : Body25Joint3d(line["joints3d"], ours);
       keypoints.push_back(p ? json{(*p)[0], (*p)[1], (*p)[2], 1.0} : json{0.0, 0.0, 0.0, 0.0});
     }
     const json people = json::array({{{"id", 0}, {"keypoints3d", keypoints}}});
-    AtomicWriteFile(out / "keypoints3d" / JsonName(f), people.dump() + "\n");
+    AtomicWriteFile(out / "keypoints3d" / FrameFileName(f, "json"), people.dump() + "\n");
   }
   Log().info("export easymocap: {} frames x {} cameras", src.manifest.frame_count, src.calibration.cameras.size());
 }
@@ -300,7 +268,7 @@ fs::path RunDatasetExport(const DatasetExportOptions& options) {
   Source src;
   src.manifest = ReadManifest(options.sequence);
   src.calibration = ReadCalibration(options.sequence);
-  src.truth = ReadTruth(options.sequence / "truth" / "frames.jsonl");
+  src.truth = ReadFrameLines(options.sequence / "truth" / "frames.jsonl");
   CheckOutputApart(options.out, {options.sequence}, "--out");
   StagingDir staging(options.out, options.overwrite, "--out", "export");
   if (options.format == DatasetFormat::kCoco) {
