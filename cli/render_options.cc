@@ -19,7 +19,7 @@ void AddRenderInputOptions(CLI::App* cmd,
          "a library motion (irbench motion list), a file in motions/ (keyframes or session "
          "script), or a path to a .json, .bvh or .amc file")
       ->capture_default_str();
-  cmd->add_option("--backend", backend, "OpenGL backend: auto, egl or osmesa")
+  cmd->add_option("--backend", backend, "OpenGL backend: auto, egl, osmesa or gpu (EGL on the first GPU)")
       ->capture_default_str();
   cmd->add_option("--supersample", o.supersample, "pinhole pixels per output pixel per axis (1-4)")
       ->capture_default_str()
@@ -38,7 +38,7 @@ void ApplyShadows(const std::string& shadows, RenderJobOptions& o) {
 
 GlBackend BackendOrThrow(const std::string& name) {
   const auto backend = ParseGlBackend(name);
-  if (!backend) throw InputError("", "--backend", "must be auto, egl or osmesa");
+  if (!backend) throw InputError("", "--backend", "must be auto, egl, osmesa or gpu");
   return *backend;
 }
 

@@ -1,8 +1,11 @@
 // EGL headless context: Mesa's surfaceless platform (or a device platform on a
-// vendor driver), OpenGL core profile, no window system.
+// vendor driver), or, for the GPU path, the device platform on the first EGL
+// device that is not Mesa's software one; OpenGL core profile, no window system.
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+
+#include <string>
 
 #include "common/error.h"
 #include "sim/gl/gl_context.h"
@@ -16,29 +19,62 @@ std::string EglErrorString(EGLint error) {
   return buffer;
 }
 
+// The first EGL device that is not Mesa's software renderer, or null.
+EGLDeviceEXT FirstHardwareDevice(std::string* seen) {
+  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+  auto query_string =
+      reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+  if (query_devices == nullptr || query_string == nullptr) {
+    *seen = "no EGL_EXT_device_enumeration";
+    return nullptr;
+  }
+  EGLDeviceEXT devices[16];
+  EGLint count = 0;
+  if (!query_devices(16, devices, &count)) count = 0;
+  *seen = std::to_string(count) + " EGL device(s)";
+  for (EGLint i = 0; i < count; ++i) {
+    const char* extensions = query_string(devices[i], EGL_EXTENSIONS);
+    const std::string ext = extensions != nullptr ? extensions : "";
+    if (ext.find("EGL_MESA_device_software") == std::string::npos) return devices[i];
+  }
+  *seen += ", all software";
+  return nullptr;
+}
+
 class EglHeadlessContext final : public GlContext {
  public:
-  EglHeadlessContext() {
+  explicit EglHeadlessContext(bool hardware_only) : hardware_only_(hardware_only) {
     auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
         eglGetProcAddress("eglGetPlatformDisplayEXT"));
     if (get_platform_display == nullptr) {
       throw RuntimeError("eglGetPlatformDisplayEXT is missing (no EGL_EXT_platform_base)");
     }
-    // Surfaceless first (Mesa); then the default device platform (vendor EGL).
-    display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
     EGLint major = 0, minor = 0;
-    if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-      // A vendor driver: the first EGL device.
-      auto query_devices =
-          reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
-      EGLDeviceEXT device = nullptr;
-      EGLint num_devices = 0;
-      display_ = EGL_NO_DISPLAY;
-      if (query_devices != nullptr && query_devices(1, &device, &num_devices) && num_devices > 0) {
-        display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
-      }
+    if (hardware_only) {
+      // The GPU path: the device platform on the first hardware device.
+      std::string seen;
+      EGLDeviceEXT device = FirstHardwareDevice(&seen);
+      if (device == nullptr) throw RuntimeError("no GPU among the EGL devices (" + seen + ")");
+      display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
       if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-        throw RuntimeError("eglInitialize failed: " + EglErrorString(eglGetError()));
+        throw RuntimeError("eglInitialize on the GPU's EGL device failed: " + EglErrorString(eglGetError()));
+      }
+    } else {
+      // Surfaceless first (Mesa); then the default device platform (vendor EGL).
+      display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
+        // A vendor driver: the first EGL device.
+        auto query_devices =
+            reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+        EGLDeviceEXT device = nullptr;
+        EGLint num_devices = 0;
+        display_ = EGL_NO_DISPLAY;
+        if (query_devices != nullptr && query_devices(1, &device, &num_devices) && num_devices > 0) {
+          display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
+        }
+        if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
+          throw RuntimeError("eglInitialize failed: " + EglErrorString(eglGetError()));
+        }
       }
     }
     const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE,
@@ -85,17 +121,18 @@ class EglHeadlessContext final : public GlContext {
     eglTerminate(display_);
   }
 
-  std::string BackendName() const override { return "egl"; }
+  std::string BackendName() const override { return hardware_only_ ? "gpu" : "egl"; }
 
  private:
+  bool hardware_only_ = false;
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
 };
 
 }  // namespace
 
-std::unique_ptr<GlContext> CreateEglHeadlessContext() {
-  return std::make_unique<EglHeadlessContext>();
+std::unique_ptr<GlContext> CreateEglHeadlessContext(bool hardware_only) {
+  return std::make_unique<EglHeadlessContext>(hardware_only);
 }
 
 }  // namespace irbench

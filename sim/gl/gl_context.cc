@@ -5,13 +5,14 @@
 
 namespace irbench {
 
-std::unique_ptr<GlContext> CreateEglHeadlessContext();  // egl_context.cc
+std::unique_ptr<GlContext> CreateEglHeadlessContext(bool hardware_only);  // egl_context.cc
 std::unique_ptr<GlContext> CreateOsMesaContext();       // osmesa_context.cc
 
 std::optional<GlBackend> ParseGlBackend(const std::string& name) {
   if (name == "auto") return GlBackend::kAuto;
   if (name == "egl") return GlBackend::kEgl;
   if (name == "osmesa") return GlBackend::kOsMesa;
+  if (name == "gpu") return GlBackend::kGpu;
   return std::nullopt;
 }
 
@@ -21,6 +22,8 @@ std::string GlBackendName(GlBackend backend) {
       return "egl";
     case GlBackend::kOsMesa:
       return "osmesa";
+    case GlBackend::kGpu:
+      return "gpu";
     case GlBackend::kAuto:
       break;
   }
@@ -36,10 +39,11 @@ std::string GlContext::RendererString() const {
 }
 
 std::unique_ptr<GlContext> CreateGlContext(GlBackend backend) {
-  if (backend == GlBackend::kEgl) return CreateEglHeadlessContext();
+  if (backend == GlBackend::kEgl) return CreateEglHeadlessContext(false);
+  if (backend == GlBackend::kGpu) return CreateEglHeadlessContext(true);
   if (backend == GlBackend::kOsMesa) return CreateOsMesaContext();
   try {
-    return CreateEglHeadlessContext();
+    return CreateEglHeadlessContext(false);
   } catch (const RuntimeError& egl_error) {
     Log().warn("EGL unavailable ({}); falling back to OSMesa", egl_error.what());
     try {

@@ -3,7 +3,10 @@
 //   egl    - EGL on Mesa's surfaceless platform (llvmpipe here; a vendor EGL
 //            where a GPU exists), the primary path;
 //   osmesa - Mesa's off-screen library, from its own module;
-//   auto   - egl, falling back to osmesa.
+//   gpu    - EGL's device platform on the first device that is not Mesa's
+//            software one (an NVIDIA, AMD or Intel GPU); an error without one;
+//   auto   - egl, falling back to osmesa (llvmpipe, the reference pixels,
+//            where Mesa is installed).
 // Contexts are OpenGL 3.3 core (or newer); all rendering goes into FBOs.
 
 #include <memory>
@@ -14,17 +17,17 @@
 
 namespace irbench {
 
-enum class GlBackend { kAuto, kEgl, kOsMesa };
+enum class GlBackend { kAuto, kEgl, kOsMesa, kGpu };
 
-// Parses "auto" | "egl" | "osmesa"; nullopt otherwise.
+// Parses "auto" | "egl" | "osmesa" | "gpu"; nullopt otherwise.
 std::optional<GlBackend> ParseGlBackend(const std::string& name);
-// "auto", "egl" or "osmesa".
+// "auto", "egl", "osmesa" or "gpu".
 std::string GlBackendName(GlBackend backend);
 
 class GlContext {
  public:
   virtual ~GlContext() = default;
-  // "egl" or "osmesa".
+  // "egl", "osmesa" or "gpu".
   virtual std::string BackendName() const = 0;
   const GlFunctions& gl() const { return gl_; }
   // GL_RENDERER and GL_VERSION strings.
