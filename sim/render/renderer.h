@@ -74,6 +74,16 @@ class Renderer {
     person_visible_ = visible;
   }
 
+  // Where RenderAll's time went since the last ResetStageTimes (s, summed).
+  struct StageTimes {
+    double draw_s = 0;           // shadow maps and every camera's draw calls
+    double read_back_s = 0;      // the pixels' way back (waiting for the GL drawing)
+    double resample_wait_s = 0;  // resampling still running after the last read-back
+    int frame_sets = 0;
+  };
+  const StageTimes& stage_times() const { return stage_times_; }
+  void ResetStageTimes() { stage_times_ = {}; }
+
   // Renders camera `index`; `out->depth` is filled only when `want_depth`.
   void Render(int index, CameraImages* out, bool want_depth);
   // Renders every camera, (*out)[i] for camera i; faster than one at a time.
@@ -100,12 +110,17 @@ class Renderer {
   void DrawPerson(int person_flag_location);
   void DrawStatic(int person_flag_location);
   void Draw(int index);
-  void Read(int index, CameraImages* out, bool want_depth);
+  // Reads camera `index`'s render targets back (GL; this thread).
+  void ReadBack(int index);
+  // Resamples camera `index`'s read-back pixels into `out` (no GL; any thread,
+  // one per camera at a time).
+  void Resample(int index, CameraImages* out, bool want_depth);
   GlContext& context_;
   const GlFunctions& gl_;
   std::vector<Camera> cameras_;
   RenderOptions options_;
   std::vector<std::unique_ptr<Target>> targets_;
+  StageTimes stage_times_;
   unsigned program_ = 0;
   unsigned shadow_program_ = 0;
   std::vector<std::unique_ptr<ShadowMap>> shadow_maps_;

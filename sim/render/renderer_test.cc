@@ -326,7 +326,7 @@ TEST(IlluminationTest, BounceLightMatchesTheIrradianceVolume) {
   renderer.SetBounce(volume);
   CameraImages images;
   renderer.Render(0, &images, false);
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(0, 0.75, 0), Eigen::Vector3d(0.375, 0.1875, 0),
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0.75, 0), Eigen::Vector3d(0.375, 0.1875, 0),
                                   Eigen::Vector3d(-0.75, -0.375, 0)}) {
     const double expected = 0.5 * volume.Irradiance(p, Eigen::Vector3d::UnitZ())[kScreenContent];
     const cv::Vec4f r = RadianceAt(images, cam, p);

@@ -68,13 +68,13 @@ cv::Mat RigExposure::Expose(size_t c,
   const cv::Mat sources = samples > 1 ? cv::Mat(radiance_sum / samples) : render.radiance;
   chain.last_flicker = WeighSources(chain, sources, start_s, exposure_s, mains, screen, sweep);
   truth["flicker"] = chain.last_flicker;
-  const cv::Mat seen = chain.optics.Apply(radiance_, render.depth);
+  const cv::Mat seen = chain.optics.Apply(chain.radiance, render.depth);
   chain.last_written =
       chain.sensor.ToOutput(chain.sensor.Expose(seen, chain.exposure_ms, noise_frame));
   return chain.last_written;
 }
 
-double RigExposure::WeighSources(const CameraChain& chain,
+double RigExposure::WeighSources(CameraChain& chain,
                                  const cv::Mat& sources,
                                  double start_s,
                                  double exposure_s,
@@ -92,17 +92,17 @@ double RigExposure::WeighSources(const CameraChain& chain,
   if (readout_s <= 0 || sources.rows < 2) {
     const float m = static_cast<float>(mains), s = static_cast<float>(screen);
     const cv::Matx14f weights(m, m * q940, s * q_content, 1.0f);
-    cv::transform(sources, radiance_, weights);
+    cv::transform(sources, chain.radiance, weights);
     lit = mains * (mean[0] + q940 * mean[1]) + screen * q_content * mean[2] + mean[3];
   } else {
-    radiance_.create(sources.size(), CV_32FC1);
+    chain.radiance.create(sources.size(), CV_32FC1);
     for (int y = 0; y < sources.rows; ++y) {
       const double row_start = start_s + (double(y) / (sources.rows - 1) - 0.5) * readout_s;
       const float m = static_cast<float>(chain.flicker.MainsMean(row_start, exposure_s));
       const float s =
           static_cast<float>(sweep >= 0 ? sweep : chain.flicker.ScreenMean(row_start, exposure_s));
       const cv::Vec4f* in_row = sources.ptr<cv::Vec4f>(y);
-      float* out_row = radiance_.ptr<float>(y);
+      float* out_row = chain.radiance.ptr<float>(y);
       double row_sum = 0;
       for (int x = 0; x < sources.cols; ++x) {
         const cv::Vec4f& v = in_row[x];

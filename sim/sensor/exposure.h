@@ -51,6 +51,8 @@ class RigExposure {
   // of 0 or more replaces the content's (the calibration sweep of empty-stage
   // frames). `t`: the frame's instant (s), the exposure's centre. Records the
   // levels, exposure and drops in `sensor_truth` under the camera's name.
+  // Calls for different cameras may run at once, each with its own
+  // `sensor_truth` object.
   cv::Mat Expose(size_t c,
                  const CleanRender& render,
                  const cv::Mat& radiance_sum,
@@ -81,15 +83,16 @@ class RigExposure {
     SensorModel sensor;
     FlickerModel flicker;
     Optics optics;
+    cv::Mat radiance;  // the weighted radiance (CV_32FC1), reused frame to frame
     cv::Mat last_written;
     double last_flicker = 1.0;  // of the image a drop repeats
   };
 
   // Weighs `sources` (CV_32FC4) by the mains level `mains` and the screens'
   // level `screen` (per row with a rolling shutter, over the exposure from
-  // `start_s`, `exposure_s` long) into radiance_ (CV_32FC1); returns the
+  // `start_s`, `exposure_s` long) into chain.radiance; returns the
   // flicker: the lit image's mean relative to the steady light's.
-  double WeighSources(const CameraChain& chain,
+  double WeighSources(CameraChain& chain,
                       const cv::Mat& sources,
                       double start_s,
                       double exposure_s,
@@ -99,7 +102,6 @@ class RigExposure {
 
   uint64_t seed_;
   std::vector<CameraChain> chains_;
-  cv::Mat radiance_;  // the weighted radiance, reused by every camera
 };
 
 }  // namespace irbench

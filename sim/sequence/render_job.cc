@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <future>
 #include <memory>
 
 #include "common/atomic_file.h"
@@ -486,15 +487,31 @@ nlohmann::json ExposeAndWriteFrameSet(RenderRun& run,
                                       bool verify) {
   const RenderInputs& in = run.in;
   const fs::path& root = run.root;
+  // Each camera's sensor chain and PNG encoding on a thread of its own (the
+  // chains share nothing); the files are written here, in camera order.
+  struct Encoded {
+    nlohmann::json truth = nlohmann::json::object();
+    std::string frame_png, mask_png;
+  };
+  std::vector<Encoded> encoded(in.rig.cameras.size());
+  std::vector<std::future<void>> done;
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    done.push_back(std::async(std::launch::async, [&run, &blur, &instant, &radiance_sums, &encoded, c, f] {
+      Encoded& e = encoded[c];
+      const cv::Mat frame = run.exposure.Expose(c, CleanRenderOf(run.all_images[c]), radiance_sums[c],
+                                                blur.samples, instant[c], f, e.truth);
+      e.frame_png = EncodePng(frame);
+      e.mask_png = EncodePng(run.all_images[c].mask);
+    }));
+  }
+  for (std::future<void>& d : done) d.get();
   nlohmann::json sensor_truth = nlohmann::json::object();
   for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
     const std::string& cam_name = in.rig.cameras[c].name;
-    const cv::Mat frame = run.exposure.Expose(c, CleanRenderOf(run.all_images[c]), radiance_sums[c], blur.samples,
-                                              instant[c], f, sensor_truth);
+    sensor_truth[cam_name] = std::move(encoded[c].truth[cam_name]);
     sensor_truth[cam_name]["sync_offset_ms"] = (instant[c] - t) * 1000.0;
-    WriteOrVerify(root / "frames" / cam_name / FrameFileName(f, "png"), EncodePng(frame), verify);
-    WriteOrVerify(root / "truth" / "masks" / cam_name / FrameFileName(f, "png"), EncodePng(run.all_images[c].mask),
-                  verify);
+    WriteOrVerify(root / "frames" / cam_name / FrameFileName(f, "png"), encoded[c].frame_png, verify);
+    WriteOrVerify(root / "truth" / "masks" / cam_name / FrameFileName(f, "png"), encoded[c].mask_png, verify);
     if (run.options.write_depth && !verify) {
       WriteDepthExrAtomic(root / "truth" / "depth" / cam_name / FrameFileName(f, "exr"),
                           run.all_images[c].depth);
