@@ -67,6 +67,9 @@ std::vector<Command> AddRenderCommand(CLI::App& app) {
                 "options left behind (its hidden .NAME.partial-PID folder); the result is the\n"
                 "same, byte for byte, as an uninterrupted render");
   cmd->add_flag("--depth", args->job.write_depth, "also write camera depth as OpenEXR");
+  cmd->add_flag("--video", args->job.write_video,
+                "also write each camera's frames and empty-stage frames as a lossless video "
+                "(videos/<cam>.mkv, background/<cam>.mkv: FFV1), trackable with irbench track --from-videos");
   return {{cmd, [cmd, args] { return RunRender(*cmd, *args); }}};
 }
 

@@ -1,5 +1,6 @@
 // `irbench track`: the tracker over a sequence folder.
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -17,7 +18,7 @@ namespace {
 // What `irbench track`'s flags bind to.
 struct TrackArgs {
   TrackJobOptions job;
-  std::string sequence, out;
+  std::string sequence, out, empty_stage;
   int frames = 0;
   // The tracker settings as typed (key -> text), applied after parsing so
   // that a bad value is one InputError naming the flag.
@@ -47,6 +48,26 @@ void AddTrackerSettingOptions(CLI::App* cmd, TrackArgs& args) {
   }
 }
 
+// "FROM:TO" in seconds, FROM >= 0 and TO > FROM.
+std::pair<double, double> ParseEmptyStage(const std::string& text) {
+  const size_t colon = text.find(':');
+  double from = 0, to = 0;
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    size_t used = 0;
+    from = std::stod(text.substr(0, colon), &used);
+    if (used != colon) throw std::invalid_argument("trailing text");
+    to = std::stod(text.substr(colon + 1), &used);
+    if (used != text.size() - colon - 1) throw std::invalid_argument("trailing text");
+  } catch (const std::exception&) {
+    throw InputError("", "--empty-stage", "expected FROM:TO in seconds (e.g. 0:2), got '" + text + "'");
+  }
+  if (!(std::isfinite(from) && std::isfinite(to) && from >= 0 && to > from)) {
+    throw InputError("", "--empty-stage", "needs 0 <= FROM < TO, got '" + text + "'");
+  }
+  return {from, to};
+}
+
 // Runs the track job; prints its output folder.
 int RunTrack(const CLI::App& cmd, TrackArgs& args) {
   TrackJobOptions& track = args.job;
@@ -55,6 +76,7 @@ int RunTrack(const CLI::App& cmd, TrackArgs& args) {
   track.out = args.out;
   for (const auto& [setting, text] : args.typed) SetFromText(*setting, text, track.tracker);
   if (cmd.count("--frames") > 0) track.frames = args.frames;
+  if (!args.empty_stage.empty()) track.input.empty_stage_s = ParseEmptyStage(args.empty_stage);
   std::cout << RunTrackJob(track).string() << "\n";
   return kExitOk;
 }
@@ -66,7 +88,15 @@ std::vector<Command> AddTrackCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "track",
       "Run the tracker on a sequence folder (frames, calibration and empty-stage frames only)");
-  cmd->add_option("SEQ", args->sequence, "sequence folder written by render")->required();
+  cmd->add_option("SEQ", args->sequence,
+                  "sequence folder written by render, or a recording: videos/<cam>.<ext>, EasyMocap "
+                  "intri.yml and extri.yml, background/<cam>.<ext> (docs/recordings.md)")
+      ->required();
+  cmd->add_flag("--from-videos", args->job.input.videos,
+                "read SEQ's videos/ (irbench render --video) even where its frames/ exist");
+  cmd->add_option("--empty-stage", args->empty_stage,
+                  "FROM:TO seconds of the videos that show the empty stage, when there are no "
+                  "background/<cam> videos");
   AddTrackerSettingOptions(cmd, *args);
   cmd->add_flag("--overlays", args->job.overlays, "also write debug overlays (PNG, colour)");
   cmd->add_flag("--ply", args->job.ply,

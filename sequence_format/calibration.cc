@@ -290,15 +290,10 @@ void WriteCalibration(const fs::path& sequence_dir,
   AtomicWriteFile(sequence_dir / kCamerasFile, CamerasJson(cameras, timing, sensors).dump(2) + "\n");
 }
 
-Calibration ReadCalibration(const fs::path& dir) {
-  const fs::path intri_file = dir / kIntriFile, extri_file = dir / kExtriFile;
-  const fs::path cameras_file = dir / kCamerasFile;
-  for (const fs::path& f : {intri_file, extri_file, cameras_file}) {
-    if (!fs::is_regular_file(f))
-      throw InputError(f.string(), "", "missing (not a sequence folder?)");
-  }
-  cv::FileStorage intri, extri;
-  OpenYaml(intri_file, extri_file, &intri, &extri);
+namespace {
+
+// The camera names of intri.yml, each checked.
+std::vector<std::string> CameraNames(const cv::FileStorage& intri, const fs::path& intri_file) {
   std::vector<std::string> names;
   try {
     intri[kNamesKey] >> names;
@@ -312,6 +307,21 @@ Calibration ReadCalibration(const fs::path& dir) {
                        problem);
     }
   }
+  return names;
+}
+
+}  // namespace
+
+Calibration ReadCalibration(const fs::path& dir) {
+  const fs::path intri_file = dir / kIntriFile, extri_file = dir / kExtriFile;
+  const fs::path cameras_file = dir / kCamerasFile;
+  for (const fs::path& f : {intri_file, extri_file, cameras_file}) {
+    if (!fs::is_regular_file(f))
+      throw InputError(f.string(), "", "missing (not a sequence folder?)");
+  }
+  cv::FileStorage intri, extri;
+  OpenYaml(intri_file, extri_file, &intri, &extri);
+  const std::vector<std::string> names = CameraNames(intri, intri_file);
   const JsonNode cameras_json = ParseJsonFile(cameras_file.string());
   const JsonNode list = cameras_json["cameras"];
   Calibration calibration;
@@ -324,6 +334,24 @@ Calibration ReadCalibration(const fs::path& dir) {
     ReadTiming(list, cameras_file.string(), cam, timing);
     calibration.cameras.push_back(cam);
     calibration.timing.push_back(timing);
+  }
+  return calibration;
+}
+
+Calibration ReadEasyMocapCalibration(const fs::path& intri_file, const fs::path& extri_file) {
+  for (const fs::path& f : {intri_file, extri_file}) {
+    if (!fs::is_regular_file(f)) throw InputError(f.string(), "", "missing");
+  }
+  cv::FileStorage intri, extri;
+  OpenYaml(intri_file, extri_file, &intri, &extri);
+  Calibration calibration;
+  for (const std::string& name : CameraNames(intri, intri_file)) {
+    Camera cam;
+    cam.name = name;
+    ReadIntrinsics(intri, intri_file.string(), cam);
+    ReadExtrinsics(extri, extri_file.string(), cam);
+    calibration.cameras.push_back(cam);
+    calibration.timing.push_back(CameraTiming{});
   }
   return calibration;
 }

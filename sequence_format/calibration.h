@@ -66,5 +66,10 @@ void WriteCalibration(const std::filesystem::path& sequence_dir,
 // rotation that is not one, a focal length <= 0, a NaN, a camera name outside
 // the safe set of CameraNameProblem: field "names[i]" of intri.yml, ...).
 Calibration ReadCalibration(const std::filesystem::path& sequence_dir);
+// EasyMocap's two files alone (a recording's calibration): intrinsics and
+// extrinsics per camera; image sizes 0 and default timing, for the caller to
+// take from the recording. Throws InputError naming the file and field.
+Calibration ReadEasyMocapCalibration(const std::filesystem::path& intri_file,
+                                     const std::filesystem::path& extri_file);
 
 }  // namespace irbench

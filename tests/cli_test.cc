@@ -435,13 +435,17 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
          "--refine-fraction: '2': must be in 0..1"},
         {{"track", (dir / "seq").string(), "--seed", "-1", "--out", (dir / "t8").string()}, "--seed"},
         {{"track", (dir / "missing").string()}, "no such sequence folder"},
+        {{"track", (dir / "seq").string(), "--empty-stage", "2", "--out", (dir / "t9").string()}, "--empty-stage"},
+        {{"track", (dir / "seq").string(), "--empty-stage", "0:2", "--out", (dir / "t9").string()},
+         "--empty-stage: applies to videos"},
+        {{"track", (dir / "seq").string(), "--from-videos", "--out", (dir / "t9").string()}, "videos"},
         {{"track", (dir / "nobg").string()}, "no empty-stage frames"}}) {
     const Result bad = RunIrbench(args, dir);
     EXPECT_EQ(bad.exit_code, 2) << bad.err;
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
-  for (const char* name : {"t2", "t3", "t4", "t5", "t6", "t7", "t8"}) EXPECT_FALSE(fs::exists(dir / name));
+  for (const char* name : {"t2", "t3", "t4", "t5", "t6", "t7", "t8", "t9"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
   // An output that would replace the sequence or land in what it reads
   // (common/atomic_file.h), or a folder irbench did not write.

@@ -20,6 +20,7 @@
 #include "sim/sensor/exposure.h"
 #include "sim/sequence/image_io.h"
 #include "sim/sequence/render_resume.h"
+#include "sim/sequence/sequence_video.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -256,6 +257,10 @@ nlohmann::json BuildManifest(const RenderJobOptions& options,
                        {"events", "truth/events.json"},
                        {"motion_bvh", "truth/motion.bvh"}};
   if (options.write_depth) manifest["files"]["depth"] = "truth/depth/<cam>/NNNNNN.exr";
+  if (options.write_video) {
+    manifest["files"]["videos"] = std::string("videos/<cam>") + kVideoExtension;
+    manifest["files"]["background_videos"] = std::string("background/<cam>") + kVideoExtension;
+  }
   return manifest;
 }
 
@@ -678,6 +683,10 @@ fs::path RunRenderJob(const RenderJobOptions& options) {
     RenderFrameSets(setup, StartRenderJournal(staging, hash, layout));
   }
   RemoveRenderJournal(staging.path());
+  if (options.write_video) {
+    Log().info("render: writing one FFV1 video per camera");
+    WriteSequenceVideos(staging.path(), CameraNames(in), in.frame_count, options.background_frames, in.fps);
+  }
   WriteManifest(staging.path(), manifest);
   ThrowIfCancelled();
   staging.Commit();

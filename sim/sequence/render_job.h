@@ -43,6 +43,7 @@ struct RenderJobOptions {
   // dead render's staging folder is removed.
   bool resume = false;
   bool write_depth = false;
+  bool write_video = false;  // also videos/<cam>.mkv, background/<cam>.mkv (FFV1; sequence_video.h)
   GlBackend backend = GlBackend::kAuto;
   int supersample = 2;
   // Soft shadows of the scene's lights; default: on with a sensor preset other

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "common/error.h"
 #include "sequence_format/calibration.h"
@@ -48,12 +50,197 @@ void CheckNoGap(const fs::path& folder, int count) {
   }
 }
 
+// The one file in `folder` whose name without extension is `camera`; empty
+// when there is none; an error when there are several.
+fs::path VideoOf(const fs::path& folder, const std::string& camera) {
+  fs::path found;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    if (!entry.is_regular_file() || entry.path().stem() != camera) continue;
+    if (!found.empty()) {
+      throw InputError(folder.string(), "",
+                       "two videos for camera '" + camera + "': " + found.filename().string() + " and " +
+                           entry.path().filename().string());
+    }
+    found = entry.path();
+  }
+  return found;
+}
+
+// 8-bit grey from a decoded video frame (FFmpeg hands grey videos back as BGR
+// with equal channels, which this keeps exactly).
+cv::Mat GreyOf(const cv::Mat& decoded) {
+  cv::Mat grey;
+  if (decoded.channels() == 3) {
+    cv::cvtColor(decoded, grey, cv::COLOR_BGR2GRAY);
+  } else if (decoded.channels() == 4) {
+    cv::cvtColor(decoded, grey, cv::COLOR_BGRA2GRAY);
+  } else {
+    grey = decoded;
+  }
+  if (grey.depth() == CV_16U) grey.convertTo(grey, CV_8U, 1.0 / 257.0);
+  return grey;
+}
+
 }  // namespace
 
-SequenceInput SequenceInput::Open(const fs::path& dir) {
+// One camera's video, decoded forwards; reading an earlier frame reopens it.
+struct SequenceInput::Video {
+  fs::path path;
+  cv::VideoCapture capture;
+  int next = 0;  // the index the next read returns
+  int count = 0;
+  cv::Size size;
+  double fps = 0;
+
+  void Reopen() {
+    capture.release();
+    if (!capture.open(path.string(), cv::CAP_ANY) || !capture.isOpened()) {
+      throw InputError(path.string(), "", "cannot be read as a video");
+    }
+    next = 0;
+  }
+
+  // Opens the video and counts its frames by decoding them (container frame
+  // counts are estimates for some formats); or, given `same`, a second
+  // reader of the same video.
+  explicit Video(fs::path file, const Video* same = nullptr) : path(std::move(file)) {
+    if (same != nullptr) {
+      count = same->count;
+      size = same->size;
+      fps = same->fps;
+      Reopen();
+      return;
+    }
+    try {
+      Reopen();
+      fps = capture.get(cv::CAP_PROP_FPS);
+      cv::Mat frame;
+      while (capture.read(frame)) {
+        if (count == 0) size = frame.size();
+        ++count;
+      }
+      Reopen();
+    } catch (const cv::Exception& e) {
+      throw InputError(path.string(), "", "cannot be read as a video: " + e.msg);
+    }
+    if (count == 0) throw InputError(path.string(), "", "no frames could be decoded");
+  }
+
+  cv::Mat Read(int index) {
+    if (index < 0 || index >= count) {
+      throw InputError(path.string(), "", "no frame " + std::to_string(index) + " (it has " + std::to_string(count) + ")");
+    }
+    if (index < next) Reopen();
+    cv::Mat frame;
+    while (next < index) {
+      if (!capture.grab()) throw InputError(path.string(), "", "ends before frame " + std::to_string(index));
+      ++next;
+    }
+    if (!capture.read(frame)) throw InputError(path.string(), "", "frame " + std::to_string(index) + " cannot be decoded");
+    ++next;
+    return frame;
+  }
+};
+
+void SequenceInput::OpenVideos(SequenceInput& in, const SequenceInputOptions& options) {
+  const fs::path& dir = in.dir_;
+  const bool has_cameras_json = fs::is_regular_file(dir / kCamerasFile);
+  if (has_cameras_json) {
+    Calibration calibration = ReadCalibration(dir);
+    in.cameras_ = std::move(calibration.cameras);
+    in.timing_ = std::move(calibration.timing);
+  } else {
+    const fs::path calib = fs::is_regular_file(dir / kIntriFile) ? dir / "calib" : dir;
+    Calibration calibration = ReadEasyMocapCalibration(calib / "intri.yml", calib / "extri.yml");
+    in.cameras_ = std::move(calibration.cameras);
+    in.timing_ = std::move(calibration.timing);
+  }
+  in.screens_ = ReadScreens(dir);
+  if (in.screens_.empty() && fs::is_regular_file(dir / "screens.json")) {
+    throw InputError((dir / "screens.json").string(), "", "screens belong in calib/screens.json");
+  }
+  const auto open_all = [&](const fs::path& folder, bool required) {
+    std::vector<std::shared_ptr<Video>> videos;
+    for (const Camera& cam : in.cameras_) {
+      const fs::path file = VideoOf(folder, cam.name);
+      if (file.empty()) {
+        if (!required && videos.empty()) return videos;
+        throw InputError(folder.string(), "", "no video for camera '" + cam.name + "' (" + cam.name + ".mkv, .avi, .mp4, ...)");
+      }
+      videos.push_back(std::make_shared<Video>(file));
+    }
+    // Every camera the same number of frames: a recording cut short is
+    // not a rig that lost frames.
+    for (size_t c = 1; c < videos.size(); ++c) {
+      if (videos[c]->count != videos[0]->count) {
+        const auto& shorter = videos[c]->count < videos[0]->count ? videos[c] : videos[0];
+        throw InputError(shorter->path.string(), "",
+                         "has " + std::to_string(shorter->count) + " frames; " +
+                             (shorter == videos[c] ? videos[0] : videos[c])->path.filename().string() + " has " +
+                             std::to_string(std::max(videos[c]->count, videos[0]->count)));
+      }
+    }
+    return videos;
+  };
+  in.videos_ = open_all(dir / "videos", true);
+  for (size_t c = 0; c < in.cameras_.size(); ++c) {
+    Camera& cam = in.cameras_[c];
+    const Video& video = *in.videos_[c];
+    if (!has_cameras_json) {
+      cam.width = video.size.width;
+      cam.height = video.size.height;
+      if (!(video.fps > 0 && std::isfinite(video.fps))) {
+        throw InputError(video.path.string(), "fps", "the video gives no frame rate");
+      }
+      in.timing_[c].fps = video.fps;
+    } else if (video.size.width != cam.width || video.size.height != cam.height) {
+      throw InputError(video.path.string(), "",
+                       "video is " + std::to_string(video.size.width) + "x" + std::to_string(video.size.height) +
+                           ", calibration says " + std::to_string(cam.width) + "x" + std::to_string(cam.height));
+    }
+  }
+  in.frame_count_ = in.videos_[0]->count;
+  in.missing_frames_.assign(in.cameras_.size(), 0);
+  if (options.empty_stage_s) {
+    const auto [from_s, to_s] = *options.empty_stage_s;
+    const int first = static_cast<int>(std::lround(from_s * in.fps()));
+    const int end = std::min(in.frame_count_, static_cast<int>(std::lround(to_s * in.fps())));
+    if (!(from_s >= 0 && to_s > from_s) || end <= first) {
+      throw InputError("", "--empty-stage", "no frames of the videos lie in that range");
+    }
+    in.background_videos_.clear();
+    for (const auto& video : in.videos_) in.background_videos_.push_back(std::make_shared<Video>(video->path, video.get()));
+    in.background_first_ = first;
+    in.background_count_ = end - first;
+    return;
+  }
+  in.background_videos_ = open_all(dir / "background", false);
+  if (in.background_videos_.empty()) {
+    throw InputError((dir / "background").string(), "",
+                     "no empty-stage videos (background/<camera>.mkv, ...); give the empty stage as a time "
+                     "range of the videos with --empty-stage FROM:TO (seconds)");
+  }
+  for (size_t c = 0; c < in.cameras_.size(); ++c) {
+    const Video& video = *in.background_videos_[c];
+    if (video.size != in.videos_[c]->size) {
+      throw InputError(video.path.string(), "", "empty-stage video's size differs from " + in.videos_[c]->path.filename().string());
+    }
+  }
+  in.background_count_ = in.background_videos_[0]->count;
+}
+
+SequenceInput SequenceInput::Open(const fs::path& dir, const SequenceInputOptions& options) {
   SequenceInput in;
   in.dir_ = dir;
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "", "no such sequence folder");
+  if (options.videos || (!fs::is_directory(dir / "frames") && fs::is_directory(dir / "videos"))) {
+    OpenVideos(in, options);
+    return in;
+  }
+  if (options.empty_stage_s) {
+    throw InputError("", "--empty-stage", "applies to videos; this sequence has frame files (frames/)");
+  }
   Calibration calibration = ReadCalibration(dir);
   in.cameras_ = std::move(calibration.cameras);
   in.timing_ = std::move(calibration.timing);
@@ -101,12 +288,14 @@ SequenceInput SequenceInput::Open(const fs::path& dir) {
 }
 
 fs::path SequenceInput::FramePath(int camera, int frame) const {
+  if (from_videos()) return videos_.at(camera)->path;
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.png", frame);
   return dir_ / "frames" / cameras_.at(camera).name / name;
 }
 
 fs::path SequenceInput::BackgroundPath(int camera, int index) const {
+  if (from_videos()) return background_videos_.at(camera)->path;
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.png", index);
   return dir_ / "background" / cameras_.at(camera).name / name;
@@ -127,12 +316,39 @@ cv::Mat SequenceInput::Load(const fs::path& path, int camera) const {
   return image;
 }
 
-cv::Mat SequenceInput::Frame(int camera, int frame) const { return Load(FramePath(camera, frame), camera); }
+cv::Mat SequenceInput::LoadVideoFrame(Video& video, int index, int camera) const {
+  cv::Mat image;
+  try {
+    image = GreyOf(video.Read(index));
+  } catch (const cv::Exception& e) {
+    throw InputError(video.path.string(), "", "frame " + std::to_string(index) + " cannot be decoded: " + e.msg);
+  }
+  const Camera& cam = cameras_.at(camera);
+  if (image.cols != cam.width || image.rows != cam.height || image.depth() != CV_8U) {
+    throw InputError(video.path.string(), "", "frame " + std::to_string(index) + " is not a " +
+                                                  std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+                                                  " 8-bit image");
+  }
+  return image;
+}
+
+cv::Mat SequenceInput::Frame(int camera, int frame) const {
+  if (from_videos()) return LoadVideoFrame(*videos_.at(camera), frame, camera);
+  return Load(FramePath(camera, frame), camera);
+}
 
 std::vector<cv::Mat> SequenceInput::TryFrameSet(int frame, std::vector<std::string>* problems) const {
   std::vector<cv::Mat> out(cameras_.size());
   problems->assign(cameras_.size(), "");
   for (size_t c = 0; c < cameras_.size(); ++c) {
+    if (from_videos()) {
+      try {
+        out[c] = Frame(static_cast<int>(c), frame);
+      } catch (const std::exception& e) {
+        (*problems)[c] = e.what();
+      }
+      continue;
+    }
     const fs::path path = FramePath(static_cast<int>(c), frame);
     if (!fs::is_regular_file(path)) {
       (*problems)[c] = path.string() + ": missing";
@@ -154,6 +370,7 @@ std::vector<cv::Mat> SequenceInput::FrameSet(int frame) const {
 }
 
 cv::Mat SequenceInput::Background(int camera, int index) const {
+  if (from_videos()) return LoadVideoFrame(*background_videos_.at(camera), background_first_ + index, camera);
   return Load(BackgroundPath(camera, index), camera);
 }
 

@@ -5,10 +5,20 @@
 // installation would survey them (calib/screens.json), the empty-stage frames
 // (background/<cam>/) and the frames (frames/<cam>/). Never truth/ and never the
 // manifest (which names the avatar and motion): a real rig has neither.
+//
+// Or a recording (docs/recordings.md): one video per camera, videos/<cam>.<ext>
+// (any format OpenCV's video I/O reads), the empty stage as background/<cam>.<ext>
+// or a time range of the videos, and the calibration as EasyMocap's
+// intri.yml and extri.yml (in calib/ or the folder itself; image sizes and
+// fps then come from the videos). A rendered sequence written with
+// `irbench render --video` is both.
 
 #include <filesystem>
+#include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/camera.h"
@@ -17,6 +27,16 @@
 
 namespace irbench {
 
+// How to open a folder: its frame files, or its videos.
+struct SequenceInputOptions {
+  // Read videos/ even when frames/ is there (a folder without frames/ is
+  // read from its videos anyway).
+  bool videos = false;
+  // The empty stage as [from, to) seconds of the videos, when there are no
+  // background videos.
+  std::optional<std::pair<double, double>> empty_stage_s;
+};
+
 class SequenceInput {
  public:
   // Throws InputError naming the file and field: a missing or unreadable
@@ -24,7 +44,10 @@ class SequenceInput {
   // or cameras with different numbers of them. Frames may be missing (a rig
   // that lost some): the sequence runs to the last frame of any camera, and
   // MissingFrames() says what is not there.
-  static SequenceInput Open(const std::filesystem::path& dir);
+  // From videos: an unreadable video, one of the wrong size (against
+  // calib/cameras.json when present) or cameras with different numbers of
+  // frames are InputErrors naming the video.
+  static SequenceInput Open(const std::filesystem::path& dir, const SequenceInputOptions& options = {});
 
   const std::filesystem::path& dir() const { return dir_; }
   const std::vector<Camera>& cameras() const { return cameras_; }
@@ -49,11 +72,16 @@ class SequenceInput {
   cv::Mat Background(int camera, int index) const;
   std::vector<cv::Mat> Backgrounds(int camera) const;
 
+  // The frame's file; from videos, the camera's video.
   std::filesystem::path FramePath(int camera, int frame) const;
   std::filesystem::path BackgroundPath(int camera, int index) const;
+  bool from_videos() const { return !videos_.empty(); }
 
  private:
+  struct Video;  // one camera's video, read forwards
+  static void OpenVideos(SequenceInput& in, const SequenceInputOptions& options);
   cv::Mat Load(const std::filesystem::path& path, int camera) const;
+  cv::Mat LoadVideoFrame(Video& video, int index, int camera) const;
 
   std::filesystem::path dir_;
   std::vector<Camera> cameras_;
@@ -62,6 +90,10 @@ class SequenceInput {
   int frame_count_ = 0;
   int background_count_ = 0;
   std::vector<int> missing_frames_;
+  // From videos: per camera, the frames' video and the empty stage's (the
+  // same one, from `background_first_`, when given as a time range).
+  std::vector<std::shared_ptr<Video>> videos_, background_videos_;
+  int background_first_ = 0;
 };
 
 }  // namespace irbench

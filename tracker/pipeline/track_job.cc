@@ -109,12 +109,15 @@ FrontEndOptions JobFrontEndOptions(const TrackJobOptions& options) {
 }
 
 // The output must not replace, hold or sit inside what it reads: the
-// sequence's frames/, background/, calib/ and the rest-state model
-// (common/atomic_file.h; the StagingDir then replaces only irbench's own).
+// sequence's frames/, background/, calib/, a recording's videos/ and
+// calibration files, and the rest-state model (common/atomic_file.h; the
+// StagingDir then replaces only irbench's own).
 void CheckOutputOutsideSequence(const TrackJobOptions& options) {
   const fs::path out = options.out.empty() ? options.sequence / "track" : options.out;
   std::vector<fs::path> inputs;
-  for (const char* part : {"frames", "background", "calib"}) inputs.push_back(options.sequence / part);
+  for (const char* part : {"frames", "background", "calib", "videos", "intri.yml", "extri.yml"}) {
+    inputs.push_back(options.sequence / part);
+  }
   inputs.push_back(options.tracker.rest_model.empty() ? DefaultRestModelPath() : options.tracker.rest_model);
   CheckOutputApart(out, inputs, "--out");
 }
@@ -365,7 +368,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   CheckTrackerSettings(settings);
   const FrontEndOptions fe_options = JobFrontEndOptions(options);
   CheckOutputOutsideSequence(options);
-  const SequenceInput input = SequenceInput::Open(options.sequence);
+  const SequenceInput input = SequenceInput::Open(options.sequence, options.input);
   const std::shared_ptr<const RestClassifier> rest_classifier = LoadRestClassifier(settings);
   int frames = input.frame_count();
   if (options.frames) {
@@ -428,6 +431,17 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                nlohmann::json(run.left_out_counts[c]).dump());
   }
   meta["cameras_left_out"] = left_out;
+  // Where the frames came from: frame files, or a recording's videos and
+  // its empty stage (docs/recordings.md).
+  nlohmann::json source = {{"kind", input.from_videos() ? "videos" : "frames"}};
+  if (input.from_videos()) {
+    source["videos"] = nlohmann::json::array();
+    for (size_t c = 0; c < nc; ++c) source["videos"].push_back(input.FramePath(static_cast<int>(c), 0).string());
+    if (options.input.empty_stage_s) {
+      source["empty_stage_s"] = {options.input.empty_stage_s->first, options.input.empty_stage_s->second};
+    }
+  }
+  meta["input"] = source;
   // The model files this track used, by content (what they are is in each
   // file's own header: how it was made).
   nlohmann::json models = nlohmann::json::object();

@@ -27,12 +27,14 @@
 #include <optional>
 #include <string>
 
+#include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/track_settings.h"
 
 namespace irbench {
 
 struct TrackJobOptions {
   std::filesystem::path sequence;
+  SequenceInputOptions input;  // frame files or videos (tracker/io/sequence_input.h)
   std::filesystem::path out;  // default: <sequence>/track
   // What the tracker computes; bound to flags, suite keys and track.json by
   // TrackSettings() (tracker/pipeline/track_settings.h).
