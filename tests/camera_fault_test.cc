@@ -14,6 +14,7 @@
 #include "sim/sequence/camera_faults.h"
 #include "sim/sequence/render_job.h"
 #include "tests/test_util.h"
+#include "tests/track_figures.h"
 #include "tracker/pipeline/track_job.h"
 
 namespace irbench {
@@ -22,22 +23,8 @@ namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
 using irbench::testing::WriteText;
 
-std::vector<nlohmann::json> ReadLines(const fs::path& path) {
-  std::vector<nlohmann::json> lines;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
-  return lines;
-}
-
-Eigen::Vector3d V(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
-
-// What a track scores as against the truth: tracked frames (of those with
-// the person present) and the mean error of the scored upper-body joints.
-struct Figures {
-  int present = 0, tracked = 0;
-  double mean_error_cm = 0;
-  double Fraction() const { return present ? static_cast<double>(tracked) / present : 0; }
-};
+using irbench::testing::ReadJsonLines;
+using Figures = irbench::testing::TrackFigures;
 
 class CameraFaultTest : public ::testing::Test {
  protected:
@@ -56,7 +43,7 @@ class CameraFaultTest : public ::testing::Test {
     options.seed = 11;
     options.out = *dir_ / "seq";
     seq_ = new fs::path(RunRenderJob(options));
-    truth_ = new std::vector<nlohmann::json>(ReadLines(*seq_ / "truth/frames.jsonl"));
+    truth_ = new std::vector<nlohmann::json>(ReadJsonLines(*seq_ / "truth/frames.jsonl"));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
@@ -69,7 +56,7 @@ class CameraFaultTest : public ::testing::Test {
     TrackJobOptions options;
     options.sequence = seq;
     options.out = *dir_ / name;
-    return ReadLines(RunTrackJob(options) / "track.jsonl");
+    return ReadJsonLines(RunTrackJob(options) / "track.jsonl");
   }
   static fs::path Fault(const std::string& spec, const std::string& name) {
     FaultJobOptions options;
@@ -79,23 +66,7 @@ class CameraFaultTest : public ::testing::Test {
     return RunFaultJob(options);
   }
   static Figures Score(const std::vector<nlohmann::json>& track) {
-    Figures f;
-    double sum = 0;
-    int n = 0;
-    for (size_t i = 0; i < track.size() && i < truth_->size(); ++i) {
-      const nlohmann::json& t = (*truth_)[i];
-      if (!t["present"].get<bool>()) continue;
-      ++f.present;
-      if (track[i]["state"] != "tracking") continue;
-      ++f.tracked;
-      for (const char* j : {"root", "waist", "neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow",
-                            "left_wrist", "right_wrist"}) {
-        sum += 100 * (V(track[i]["joints3d"][j]) - V(t["joints3d"][j])).norm();
-        ++n;
-      }
-    }
-    f.mean_error_cm = n ? sum / n : 0;
-    return f;
+    return irbench::testing::UpperBodyFigures(track, *truth_);
   }
   // The frames on which `camera` was left out, and why.
   static std::map<int, std::string> LeftOut(const std::vector<nlohmann::json>& track, const std::string& camera) {

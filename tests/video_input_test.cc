@@ -17,6 +17,7 @@
 #include "sim/sequence/render_job.h"
 #include "sim/sequence/render_resume.h"
 #include "tests/test_util.h"
+#include "tests/track_figures.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/track_job.h"
 
@@ -25,12 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
 
-std::vector<nlohmann::json> ReadLines(const fs::path& path) {
-  std::vector<nlohmann::json> lines;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
-  return lines;
-}
+using irbench::testing::ReadJsonLines;
 
 SequenceInputOptions FromVideos() {
   SequenceInputOptions options;
@@ -43,8 +39,6 @@ SequenceInputOptions EmptyStage(double from_s, double to_s) {
   options.empty_stage_s = std::pair{from_s, to_s};
   return options;
 }
-
-Eigen::Vector3d V(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
 
 // One video from numbered PNG files, with OpenCV's own MJPEG writer at
 // `quality`, or `count` frames of `size` noise when `folder` is empty.
@@ -88,7 +82,7 @@ class VideoInputTest : public ::testing::Test {
     options.write_video = true;
     options.out = *dir_ / "seq";
     seq_ = new fs::path(RunRenderJob(options));
-    truth_ = new std::vector<nlohmann::json>(ReadLines(*seq_ / "truth/frames.jsonl"));
+    truth_ = new std::vector<nlohmann::json>(ReadJsonLines(*seq_ / "truth/frames.jsonl"));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
@@ -102,24 +96,13 @@ class VideoInputTest : public ::testing::Test {
     options.sequence = seq;
     options.input = input;
     options.out = *dir_ / name;
-    return ReadLines(RunTrackJob(options) / "track.jsonl");
+    return ReadJsonLines(RunTrackJob(options) / "track.jsonl");
   }
   // Mean error (cm) of the upper-body joints over the tracked frames with
   // the person present, and how many frames were tracked.
   static std::pair<double, int> Error(const std::vector<nlohmann::json>& track) {
-    double sum = 0;
-    int n = 0, tracked = 0;
-    for (size_t i = 0; i < track.size() && i < truth_->size(); ++i) {
-      const nlohmann::json& t = (*truth_)[i];
-      if (!t["present"].get<bool>() || track[i]["state"] != "tracking") continue;
-      ++tracked;
-      for (const char* j : {"root", "waist", "neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow",
-                            "left_wrist", "right_wrist"}) {
-        sum += 100 * (V(track[i]["joints3d"][j]) - V(t["joints3d"][j])).norm();
-        ++n;
-      }
-    }
-    return {n ? sum / n : 0, tracked};
+    const irbench::testing::TrackFigures f = irbench::testing::UpperBodyFigures(track, *truth_);
+    return {f.mean_error_cm, f.tracked};
   }
   static std::vector<std::string> Cameras() { return {"front_left", "front_right", "overhead", "side"}; }
   // A recording's layout of the sequence: MJPEG videos at `quality`, the
