@@ -18,6 +18,7 @@
 #include "tracker/frontend/camera_health.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/hull/ply.h"
+#include "tracker/pipeline/frame_tracker.h"
 #include "tracker/pose/pose_tracker.h"
 
 namespace irbench {
@@ -86,20 +87,6 @@ cv::Mat Overlay(const cv::Mat& frame, const CameraFeatures& f, const AxisView* v
   return out;
 }
 
-// A world point as JSON, to 0.1 mm.
-nlohmann::json Rounded(const Eigen::Vector3d& p) {
-  return {std::round(p.x() * 1e4) / 1e4, std::round(p.y() * 1e4) / 1e4, std::round(p.z() * 1e4) / 1e4};
-}
-
-const char* Part3dName(BodyPart part) {
-  switch (part) {
-    case BodyPart::kHead: return "head";
-    case BodyPart::kTorso: return "torso";
-    default: return "arm";
-  }
-}
-
-
 // The front end's options for this job: the settings' (edge scale applied),
 // the polyhedral hull built when it is written (--ply).
 FrontEndOptions JobFrontEndOptions(const TrackJobOptions& options) {
@@ -122,243 +109,42 @@ void CheckOutputOutsideSequence(const TrackJobOptions& options) {
   CheckOutputApart(out, inputs, "--out");
 }
 
-// The rest-state model (pose stage), loaded before any work is done; null
-// (with a warning) when the default model is absent.
-std::shared_ptr<const RestClassifier> LoadRestClassifier(const TrackerSettings& settings) {
-  if (settings.stage != TrackStage::kPose) return nullptr;
-  const fs::path rest_path = settings.rest_model.empty() ? DefaultRestModelPath() : settings.rest_model;
-  if (!settings.rest_model.empty() || fs::exists(rest_path)) {
-    return std::make_shared<RestClassifier>(RestClassifier::Load(rest_path));
-  }
-  Log().warn("track: no rest-state model at {} (irbench train rest); rest stays null", rest_path.string());
-  return nullptr;
-}
-
-// features.jsonl's per-camera entry: silhouette area, axis points by part,
-// polygon edges, shadow pixels removed, light level, blobs removed.
-nlohmann::json CameraFeaturesJson(const FrameFeatures& features, size_t c) {
-  const CameraFeatures& cf = features.cameras[c];
-  std::map<std::string, int> parts;
-  if (c < features.views.size()) {
-    const AxisView& v = features.views[c];
-    int kept = 0;
-    for (const AxisPoint2d& p : v.graph.points) kept += p.kept;
-    parts["axis_points"] = kept;
-    for (BodyPart b : v.labels) {
-      if (b != BodyPart::kNone) ++parts[BodyPartName(b)];
-    }
-  }
-  nlohmann::json j;
-  j["health"] = CameraHealthName(cf.health);
-  j["mean_level"] = std::round(cf.mean_level * 100) / 100;
-  j["polygon_edges"] = c < features.polygons.size() ? features.polygons[c].EdgeCount() : 0;
-  j.update({{"silhouette_area", cv::countNonZero(cf.silhouette)},
-            {"axis", parts},
-            {"shadow_pixels_removed", cv::countNonZero(cf.before_shadows & ~cf.silhouette)},
-            {"light_level", cf.light_level},
-            {"blobs_removed", cf.blobs_removed}});
-  return j;
-}
-
-// features.jsonl's hull part: 3D axis points, voxels, placement, polyhedral hull.
-void AddHullFeatures(const FrameFeatures& features, const std::vector<Camera>& cameras, nlohmann::json& line) {
-  nlohmann::json axis3d = nlohmann::json::array();
-  for (const AxisPoint3d& a : features.axis3d) {
-    axis3d.push_back({{"p", Rounded(a.p_in_world)},
-                      {"part", Part3dName(a.part)},
-                      {"diameter_m", std::round(a.diameter_m * 1e4) / 1e4},
-                      {"support", a.support}});
-  }
-  line["axis3d"] = axis3d;
-  if (features.voxels) {
-    line["voxels"] = {{"occupied", features.voxels->occupied_count},
-                      {"volume_m3", std::round(features.voxels->VolumeM3() * 1e5) / 1e5},
-                      {"voxel_size_m", features.voxels->voxel_size_m}};
-  }
-  line["placement"] =
-      features.placement
-          ? nlohmann::json{{"root", Rounded(features.placement->root)},
-                           {"top_m", std::round(features.placement->top_m * 1e3) / 1e3},
-                           {"dropped_view", features.placement->dropped_view < 0
-                                                ? nlohmann::json(nullptr)
-                                                : nlohmann::json(cameras[features.placement->dropped_view].name)},
-                           {"dropped_view_coverage", std::round(features.placement->dropped_view_coverage * 1e3) / 1e3}}
-          : nlohmann::json(nullptr);
-  line["polyhedral_hull"] =
-      features.hull ? nlohmann::json{{"vertices", features.hull->vertices.size()},
-                                     {"triangles", features.hull->triangles.size()},
-                                     {"volume_m3", std::round(MeshVolume(*features.hull) * 1e5) / 1e5}}
-                    : nlohmann::json(nullptr);
-}
-
-// track.jsonl's pointing rays (right, left) with their screen hits.
-nlohmann::json PointingJson(const PoseEstimate& pose) {
-  nlohmann::json pointing = nlohmann::json::object();
-  for (int side = 0; side < 2; ++side) {
-    const auto& ray = pose.pointing[side];
-    nlohmann::json j = nullptr;
-    if (ray) {
-      j = {{"origin", Rounded(ray->origin)}, {"dir", Rounded(ray->dir)}, {"screen", nullptr},
-           {"screen_hit", nullptr}, {"target", nullptr}};
-      if (ray->screen_hit) {
-        j["screen"] = *ray->screen;
-        j["screen_hit"] = {std::round(ray->screen_hit->x() * 1e4) / 1e4, std::round(ray->screen_hit->y() * 1e4) / 1e4};
-        if (ray->target) j["target"] = *ray->target;
-      }
-    }
-    pointing[side == 0 ? "right" : "left"] = j;
-  }
-  return pointing;
-}
-
-// A track.jsonl line (docs/architecture.md, "Tracker output"): what the stages
-// built so far know; everything else null, never invented. Adds the pose's
-// per-camera overlap to the features line.
-nlohmann::json TrackLine(int f, double t, const FrameFeatures& features, const std::optional<PoseEstimate>& pose,
-                         const std::vector<Camera>& cameras, nlohmann::json& line) {
-  nlohmann::json track_line;
-  track_line["frame"] = f;
-  track_line["t"] = t;
-  const bool tracking = pose ? pose->tracking : features.placement.has_value();
-  // "partial": someone is there but not yet (or no longer) in every view.
-  track_line["state"] = tracking ? "tracking" : (pose && features.placement && !pose->in_view) ? "partial" : "empty";
-  nlohmann::json joints = nlohmann::json::object();
-  for (const char* name : {"root", "waist", "neck", "head", "left_shoulder", "left_elbow", "left_wrist",
-                           "left_hand_tip", "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
-                           "left_hip", "left_knee", "left_ankle", "right_hip", "right_knee", "right_ankle"}) {
-    joints[name] = nullptr;
-  }
-  for (const char* key : {"dof", "pointing", "rest", "posture", "gesture", "motion"}) track_line[key] = nullptr;
-  track_line["height_m"] = nullptr;
-  if (pose && pose->tracking) {
-    for (int j = 0; j < kModelJointCount; ++j) joints[ModelJointName(j)] = Rounded(pose->body.joints[j]);
-    nlohmann::json dof = nlohmann::json::object();
-    for (int d = 0; d < kDofCount; ++d) dof[BodyDofName(d)] = std::round(pose->pose.dof[d] * 1e5) / 1e5;
-    track_line["dof"] = dof;
-    track_line["pointing"] = PointingJson(*pose);
-    if (pose->rest[0] && pose->rest[1]) track_line["rest"] = {{"right", *pose->rest[0]}, {"left", *pose->rest[1]}};
-    track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
-    track_line["girth"] = std::round(pose->shape.girth * 1e3) / 1e3;
-    track_line["arm_thickness"] = std::round(pose->shape.arm_thickness * 1e3) / 1e3;
-    nlohmann::json overlap = nlohmann::json::object();
-    for (size_t c = 0; c < pose->overlap.size(); ++c) {
-      overlap[cameras[c].name] =
-          std::isnan(pose->overlap[c]) ? nlohmann::json(nullptr) : nlohmann::json(std::round(pose->overlap[c] * 1e4) / 1e4);
-    }
-    line["pose_overlap"] = overlap;
-  } else if (!pose && features.placement) {
-    const Eigen::Vector3d& r = features.placement->root;
-    joints["root"] = {std::round(r.x() * 1e4) / 1e4, std::round(r.y() * 1e4) / 1e4, 0.0};
-    track_line["height_m"] = std::round(features.placement->top_m * 1e3) / 1e3;
-  }
-  track_line["joints3d"] = joints;
-  // The cameras this frame-set was tracked without, and why (camera_health.h).
-  nlohmann::json left_out = nlohmann::json::object();
-  for (size_t c = 0; c < features.cameras.size(); ++c) {
-    if (features.LeftOut(c)) left_out[cameras[c].name] = CameraHealthName(features.cameras[c].health);
-  }
-  track_line["cameras_left_out"] = left_out;
-  return track_line;
-}
-
-// Milliseconds per stage, for both lines.
-nlohmann::json StageMs(const FrameFeatures& features, const std::optional<PoseEstimate>& pose) {
-  nlohmann::json ms = {{"silhouettes", features.ms_silhouettes}, {"axes", features.ms_axes},
-                       {"polygons", features.ms_polygons},       {"voxels", features.ms_voxels},
-                       {"polyhedral_hull", features.ms_polyhedral}};
-  if (pose) {
-    ms["pose"] = pose->ms_total;
-    ms["pose_observation"] = pose->ms_observation;
-    ms["pose_refine"] = pose->ms_refine;
-  }
-  return ms;
-}
-
 // What a track job holds while it runs over the frames.
 struct TrackRun {
   const TrackJobOptions& options;
   const SequenceInput& input;
-  const FrontEnd& front_end;
-  std::optional<PoseTracker>& pose_tracker;
+  FrameTracker& tracker;
   fs::path root;  // the staging folder
   std::string lines, track_lines;
-  CameraHealthMonitor health;
-  std::vector<CameraHealth> last_health;  // per camera, to warn on changes
-  std::vector<std::map<std::string, int>> left_out_counts;  // per camera, frame-sets by reason
 };
 
-// Reads frame-set f, tolerating faults, and decides which cameras to leave
-// out; warns when a camera's state changes.
-std::vector<cv::Mat> ReadFrameSet(int f, TrackRun& run, std::vector<CameraStatus>* status) {
-  const SequenceInput& input = run.input;
-  std::vector<std::string> problems;
-  std::vector<cv::Mat> images = input.TryFrameSet(f, &problems);
-  *status = run.health.Update(images);
-  for (size_t c = 0; c < images.size(); ++c) {
-    const CameraHealth h = (*status)[c].health;
-    const std::string& name = input.cameras()[c].name;
-    if (h != run.last_health[c] && h == CameraHealth::kOk) {
-      Log().warn("track: camera {} ok again from frame {}", name, f);
-    } else if (h != run.last_health[c]) {
-      Log().warn("track: camera {} {} from frame {}{}{}", name, CameraHealthName(h), f,
-                 problems[c].empty() ? "" : " (" + problems[c] + ")",
-                 h == CameraHealth::kMissing || run.front_end.options().health.leave_out ? ": left out" : "");
-    } else if (!problems[c].empty()) {
-      Log().debug("track: frame {} of camera {} skipped: {}", f, name, problems[c]);
-    }
-    run.last_health[c] = h;
-    // A missing frame is drawn black (silhouettes, overlays).
-    if (images[c].empty()) images[c] = cv::Mat::zeros(input.cameras()[c].height, input.cameras()[c].width, CV_8U);
-  }
-  return images;
-}
-
-// Processes frame f: front end, pose, the silhouettes (and overlays, PLY)
-// written, a line appended to each JSONL.
+// Tracks frame f: the silhouettes (and overlays, PLY) written, a line
+// appended to each JSONL.
 void TrackFrame(int f, TrackRun& run) {
   const TrackJobOptions& options = run.options;
   const SequenceInput& input = run.input;
-  std::vector<CameraStatus> status;
-  const std::vector<cv::Mat> images = ReadFrameSet(f, run, &status);
-  std::vector<bool> left_out(status.size());
-  for (size_t c = 0; c < status.size(); ++c) {
-    left_out[c] = status[c].health == CameraHealth::kMissing ||
-                  (!status[c].usable() && run.front_end.options().health.leave_out);
-    if (left_out[c]) ++run.left_out_counts[c][CameraHealthName(status[c].health)];
-  }
-  FrameFeatures features = run.front_end.Process(f, images, left_out);
-  for (size_t c = 0; c < status.size(); ++c) {
-    features.cameras[c].health = status[c].health;
-    features.cameras[c].mean_level = status[c].mean_level;
-  }
-  std::optional<PoseEstimate> pose;
-  if (run.pose_tracker) pose = run.pose_tracker->Step(features, 1.0 / input.fps());
-  nlohmann::json line;
-  line["frame"] = f;
-  line["t"] = f / input.fps();
+  std::vector<std::string> problems;
+  std::vector<cv::Mat> read = input.TryFrameSet(f, &problems);
+  const FrameTracker::Step step = run.tracker.Track(f, std::move(read), problems, 1.0 / input.fps());
+  const FrameFeatures& features = step.features;
   for (size_t c = 0; c < input.cameras().size(); ++c) {
     const std::string& name = input.cameras()[c].name;
-    line["cameras"][name] = CameraFeaturesJson(features, c);
     WritePng(run.root / "silhouettes" / name / FrameName(f), features.cameras[c].silhouette);
     if (options.overlays) {
       const AxisView* view = c < features.views.size() ? &features.views[c] : nullptr;
-      cv::Mat overlay = Overlay(images[c], features.cameras[c], view, features.axis3d);
-      if (pose && pose->tracking) DrawModel(&overlay, input.cameras()[c], pose->body);
+      cv::Mat overlay = Overlay(step.images[c], features.cameras[c], view, features.axis3d);
+      if (step.pose && step.pose->tracking) DrawModel(&overlay, input.cameras()[c], step.pose->body);
       WritePng(run.root / "overlays" / name / FrameName(f), overlay);
     }
   }
-  AddHullFeatures(features, input.cameras(), line);
-  nlohmann::json track_line = TrackLine(f, f / input.fps(), features, pose, input.cameras(), line);
-  line["ms"] = StageMs(features, pose);
   if (options.ply) {
     char stem[32];
     std::snprintf(stem, sizeof(stem), "%06d", f);
     if (features.voxels) WriteVoxelCubesPly(run.root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
     if (features.hull) WriteMeshPly(run.root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
   }
-  track_line["ms"] = line["ms"];
-  run.lines += line.dump() + "\n";
-  run.track_lines += track_line.dump() + "\n";
+  run.lines += step.features_line.dump() + "\n";
+  run.track_lines += step.track_line.dump() + "\n";
 }
 
 }  // namespace
@@ -383,22 +169,12 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     fs::create_directories(root / "silhouettes" / cam.name);
     if (options.overlays) fs::create_directories(root / "overlays" / cam.name);
   }
-  const auto train_start = std::chrono::steady_clock::now();
-  const FrontEnd front_end = FrontEnd::Train(input, fe_options);
-  const double train_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - train_start).count();
+  FrameTracker tracker(input, settings, fe_options, rest_classifier);
+  const double train_ms = tracker.train_ms();
   Log().info("track: background models for {} cameras from {} empty-stage frames in {:.0f} ms",
              input.cameras().size(), input.background_count(), train_ms);
-
-  std::optional<PoseTracker> pose_tracker;
-  if (settings.stage == TrackStage::kPose) {
-    pose_tracker.emplace(input.cameras(), input.screens(), settings.pose);
-    if (rest_classifier) pose_tracker->set_rest_classifier(rest_classifier);
-  }
   const size_t nc = input.cameras().size();
-  TrackRun run{options, input, front_end, pose_tracker, root, "", "",
-               CameraHealthMonitor(front_end.camera_references(), fe_options.health),
-               std::vector<CameraHealth>(nc, CameraHealth::kOk), std::vector<std::map<std::string, int>>(nc)};
+  TrackRun run{options, input, tracker, root, "", ""};
   for (size_t c = 0; c < nc; ++c) {
     if (input.MissingFrames()[c] > 0) {
       Log().warn("track: camera {} lacks {} of {} frames; tracked without it there", input.cameras()[c].name,
@@ -423,12 +199,13 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
                {"train_ms", train_ms}});
   nlohmann::json left_out = nlohmann::json::object();
   for (size_t c = 0; c < nc; ++c) {
-    if (run.left_out_counts[c].empty()) continue;
-    left_out[input.cameras()[c].name] = run.left_out_counts[c];
+    const std::map<std::string, int>& counts = tracker.left_out_counts()[c];
+    if (counts.empty()) continue;
+    left_out[input.cameras()[c].name] = counts;
     int total = 0;
-    for (const auto& [reason, n] : run.left_out_counts[c]) total += n;
+    for (const auto& [reason, n] : counts) total += n;
     Log().warn("track: camera {} was left out of {} of {} frame-sets ({})", input.cameras()[c].name, total, frames,
-               nlohmann::json(run.left_out_counts[c]).dump());
+               nlohmann::json(counts).dump());
   }
   meta["cameras_left_out"] = left_out;
   // Where the frames came from: frame files, or a recording's videos and

@@ -1,0 +1,64 @@
+#pragma once
+// The tracker frame-set by frame-set over a sequence's cameras: which cameras
+// to leave out (camera health), the front end, the pose tracker, and the
+// lines of features.jsonl and track.jsonl (docs/architecture.md, "Tracker
+// output"). `irbench track` writes what it gives; `irbench live` publishes it.
+
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tracker/frontend/camera_health.h"
+#include "tracker/frontend/frontend.h"
+#include "tracker/io/sequence_input.h"
+#include "tracker/pipeline/track_settings.h"
+#include "tracker/pose/pose_tracker.h"
+
+namespace irbench {
+
+// The rest-state model the settings name, or the shipped one (pose stage
+// only); null, with a warning, when the shipped one is absent. Throws
+// InputError for a named model that cannot be read.
+std::shared_ptr<const RestClassifier> LoadRestClassifier(const TrackerSettings& settings);
+
+class FrameTracker {
+ public:
+  // Trains the front end on `input`'s empty-stage frames (which must outlive
+  // the tracker); the pose tracker when the settings' stage is pose.
+  FrameTracker(const SequenceInput& input,
+               const TrackerSettings& settings,
+               const FrontEndOptions& front_end_options,
+               std::shared_ptr<const RestClassifier> rest_classifier);
+
+  struct Step {
+    std::vector<cv::Mat> images;  // as read; black where a camera's frame is missing
+    FrameFeatures features;
+    std::optional<PoseEstimate> pose;
+    nlohmann::json features_line;  // features.jsonl's line, with "ms"
+    nlohmann::json track_line;     // track.jsonl's line, with "ms"
+  };
+  // Frame-set `f` as SequenceInput::TryFrameSet read it (`problems` per
+  // camera), `dt` s after the last one tracked; warns when a camera's state
+  // changes.
+  Step Track(int f, std::vector<cv::Mat> images, const std::vector<std::string>& problems, double dt);
+
+  double train_ms() const { return train_ms_; }
+  const FrontEnd& front_end() const { return front_end_; }
+  // Per camera, how many frame-sets it was left out of, by reason.
+  const std::vector<std::map<std::string, int>>& left_out_counts() const { return left_out_counts_; }
+
+ private:
+  const SequenceInput& input_;
+  double train_ms_ = 0;
+  FrontEnd front_end_;
+  std::optional<PoseTracker> pose_tracker_;
+  CameraHealthMonitor health_;
+  std::vector<CameraHealth> last_health_;  // per camera, to warn on changes
+  std::vector<std::map<std::string, int>> left_out_counts_;
+};
+
+}  // namespace irbench
