@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake pkg-config
   libeigen3-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
-  libopencv-calib3d-dev libopencv-ml-dev libopencv-videoio-dev
+  libopencv-calib3d-dev libopencv-ml-dev libopencv-videoio-dev liblo-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
   libopenexr-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev

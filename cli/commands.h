@@ -45,5 +45,7 @@ std::vector<Command> AddFaultCommand(CLI::App& app);
 std::vector<Command> AddExportCommand(CLI::App& app);
 // Adds `bench render|track`: throughput figures.
 std::vector<Command> AddBenchCommand(CLI::App& app);
+// `irbench live`: the tracker as frame-sets arrive, over OSC (live_command.cc).
+std::vector<Command> AddLiveCommand(CLI::App& app);
 
 }  // namespace irbench::cli

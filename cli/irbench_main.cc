@@ -31,7 +31,7 @@ std::vector<Command> AddCommands(CLI::App& app) {
                            irbench::cli::AddDemoCommand, irbench::cli::AddSuiteCommand,
                            irbench::cli::AddScoreCommand, irbench::cli::AddMotionCommand,
                            irbench::cli::AddAvatarCommand, irbench::cli::AddTrainCommand,
-                           irbench::cli::AddFaultCommand, irbench::cli::AddExportCommand,
+                           irbench::cli::AddFaultCommand, irbench::cli::AddExportCommand, irbench::cli::AddLiveCommand,
                            irbench::cli::AddBenchCommand}) {
     for (Command& command : add(app)) commands.push_back(std::move(command));
   }

@@ -1,6 +1,7 @@
 #include "cli/option_checks.h"
 
 #include <charconv>
+#include <cmath>
 #include <limits>
 
 #include "common/error.h"
@@ -53,6 +54,26 @@ void RequireNotEmpty(const CLI::App& cmd, const std::string& option, const std::
   if (cmd.count(option) > 0 && value.empty()) {
     throw InputError("", option, "is empty; give a path (or leave the option out for the default)");
   }
+}
+
+// "FROM:TO" in seconds, FROM >= 0 and TO > FROM.
+std::pair<double, double> ParseEmptyStage(const std::string& text) {
+  const size_t colon = text.find(':');
+  double from = 0, to = 0;
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    size_t used = 0;
+    from = std::stod(text.substr(0, colon), &used);
+    if (used != colon) throw std::invalid_argument("trailing text");
+    to = std::stod(text.substr(colon + 1), &used);
+    if (used != text.size() - colon - 1) throw std::invalid_argument("trailing text");
+  } catch (const std::exception&) {
+    throw InputError("", "--empty-stage", "expected FROM:TO in seconds (e.g. 0:2), got '" + text + "'");
+  }
+  if (!(std::isfinite(from) && std::isfinite(to) && from >= 0 && to > from)) {
+    throw InputError("", "--empty-stage", "needs 0 <= FROM < TO, got '" + text + "'");
+  }
+  return {from, to};
 }
 
 }  // namespace irbench::cli

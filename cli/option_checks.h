@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 namespace irbench::cli {
 
@@ -21,5 +22,8 @@ CLI::Validator Uint64Text();
 // Throws InputError naming `option` when it was given but empty (`--out ''`
 // would otherwise mean "the default folder").
 void RequireNotEmpty(const CLI::App& cmd, const std::string& option, const std::string& value);
+
+// --empty-stage's "FROM:TO" (seconds, 0 <= FROM < TO); InputError otherwise.
+std::pair<double, double> ParseEmptyStage(const std::string& text);
 
 }  // namespace irbench::cli

@@ -66,13 +66,19 @@ TEST(CliTest, HelpOnEveryCommand) {
         {"avatar", "list", "--help"}, {"avatar", "info", "--help"}, {"avatar", "export", "--help"},
         {"export", "--help"},
         {"track", "--help"}, {"bench", "track", "--help"}, {"score", "--help"}, {"demo", "--help"}, {"suite", "run", "--help"},
-        {"fault", "--help"}, {"train", "rest", "--help"}}) {
+        {"fault", "--help"}, {"train", "rest", "--help"}, {"live", "--help"}}) {
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("Usage:"), std::string::npos) << args.back();
   }
   EXPECT_EQ(RunIrbench({"render", "--no-such-option"}, dir).exit_code, 2);
   EXPECT_EQ(RunIrbench({}, dir).exit_code, 2);
+  // live: an unknown OSC host or a bad port is one line, exit 2.
+  for (const char* osc : {"no-such-host.invalid:9000", "127.0.0.1:0", "127.0.0.1"}) {
+    const Result r = RunIrbench({"live", dir.string(), "--osc", osc}, dir);
+    EXPECT_EQ(r.exit_code, 2) << osc;
+    EXPECT_NE(r.err.find("--osc"), std::string::npos) << r.err;
+  }
 }
 
 const char* kGoodCamera = R"({"name": "c0", "fx": 300, "fy": 300, "cx": 160, "cy": 120,
