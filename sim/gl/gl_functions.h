@@ -12,6 +12,7 @@ namespace irbench {
 #define IRBENCH_GL_FUNCTIONS(X)                                        \
   X(PFNGLGETSTRINGPROC, GetString)                                     \
   X(PFNGLGETERRORPROC, GetError)                                       \
+  X(PFNGLGETINTEGERVPROC, GetIntegerv)                                 \
   X(PFNGLVIEWPORTPROC, Viewport)                                       \
   X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                             \
   X(PFNGLENABLEPROC, Enable)                                           \
