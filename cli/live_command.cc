@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "cli/option_checks.h"
+#include "cli/tracker_options.h"
 #include "common/error.h"
 #include "tracker/live/live_job.h"
 
@@ -18,11 +19,13 @@ struct LiveArgs {
   std::string source, osc = "127.0.0.1:9000", record, empty_stage;
   double fps = 0;
   int frames = 0;
+  TypedTrackerSettings settings;
 };
 
 int RunLive(const CLI::App& cmd, LiveArgs& args) {
   LiveJobOptions& live = args.job;
   live.source = args.source;
+  args.settings.ApplyTo(live.tracker);
   live.osc = ParseOscTarget(args.osc, "--osc");
   RequireNotEmpty(cmd, "--record", args.record);
   live.record = args.record;
@@ -50,6 +53,7 @@ std::vector<Command> AddLiveCommand(CLI::App& app) {
       "waiting one, which is dropped and counted. Prints the latency from arrival to message.\n"
       "  irbench live renders/demo --osc 127.0.0.1:9000 --record live.jsonl");
   cmd->add_option("SOURCE", args->source, "sequence folder or recording (docs/recordings.md)")->required();
+  AddTrackerSettingOptions(cmd, args->settings);
   cmd->add_option("--osc", args->osc, "where to send: HOST:PORT (UDP)")->capture_default_str();
   cmd->add_option("--fps", args->fps, "arrival rate, frame-sets per second (default: the source's)")
       ->check(CLI::PositiveNumber);

@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/option_checks.h"
+#include "cli/tracker_options.h"
 #include "common/error.h"
 #include "tracker/pipeline/track_job.h"
 
@@ -19,33 +20,8 @@ struct TrackArgs {
   TrackJobOptions job;
   std::string sequence, out, empty_stage;
   int frames = 0;
-  // The tracker settings as typed (key -> text), applied after parsing so
-  // that a bad value is one InputError naming the flag.
-  std::vector<std::pair<const TrackSetting*, std::string>> typed;
+  TypedTrackerSettings settings;
 };
-
-// One flag per tracker setting, from the binding table (track_settings.h).
-void AddTrackerSettingOptions(CLI::App* cmd, TrackArgs& args) {
-  for (const TrackSetting& setting : TrackSettings()) {
-    if (const auto* flag = std::get_if<BoolBinding>(&setting.binding)) {
-      cmd->add_flag_callback(
-          setting.flag,
-          [&args, &setting, value = flag->flag_value] {
-            args.typed.emplace_back(&setting, value ? "true" : "false");
-          },
-          setting.help);
-      continue;
-    }
-    CLI::Option* option = cmd->add_option_function<std::string>(
-        setting.flag,
-        [&args, &setting](const std::string& text) { args.typed.emplace_back(&setting, text); },
-        setting.help);
-    option->type_name(TypeName(setting));
-    if (const std::string default_text = DefaultText(setting); !default_text.empty()) {
-      option->default_str(default_text);
-    }
-  }
-}
 
 // Runs the track job; prints its output folder.
 int RunTrack(const CLI::App& cmd, TrackArgs& args) {
@@ -53,7 +29,7 @@ int RunTrack(const CLI::App& cmd, TrackArgs& args) {
   track.sequence = args.sequence;
   RequireNotEmpty(cmd, "--out", args.out);
   track.out = args.out;
-  for (const auto& [setting, text] : args.typed) SetFromText(*setting, text, track.tracker);
+  args.settings.ApplyTo(track.tracker);
   if (cmd.count("--frames") > 0) track.frames = args.frames;
   if (!args.empty_stage.empty()) track.input.empty_stage_s = ParseEmptyStage(args.empty_stage);
   std::cout << RunTrackJob(track).string() << "\n";
@@ -76,7 +52,7 @@ std::vector<Command> AddTrackCommand(CLI::App& app) {
   cmd->add_option("--empty-stage", args->empty_stage,
                   "FROM:TO seconds of the videos that show the empty stage, when there are no "
                   "background/<cam> videos");
-  AddTrackerSettingOptions(cmd, *args);
+  AddTrackerSettingOptions(cmd, args->settings);
   cmd->add_flag("--overlays", args->job.overlays, "also write debug overlays (PNG, colour)");
   cmd->add_flag("--ply", args->job.ply,
                 "also write the voxel and polyhedral hulls per frame as PLY");

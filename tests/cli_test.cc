@@ -79,6 +79,10 @@ TEST(CliTest, HelpOnEveryCommand) {
     EXPECT_EQ(r.exit_code, 2) << osc;
     EXPECT_NE(r.err.find("--osc"), std::string::npos) << r.err;
   }
+  // ... and the tracker's settings are track's flags, checked the same way.
+  const Result particles = RunIrbench({"live", dir.string(), "--particles", "0"}, dir);
+  EXPECT_EQ(particles.exit_code, 2);
+  EXPECT_NE(particles.err.find("--particles"), std::string::npos) << particles.err;
 }
 
 const char* kGoodCamera = R"({"name": "c0", "fx": 300, "fy": 300, "cx": 160, "cy": 120,
