@@ -16,20 +16,15 @@
 #include "common/error.h"
 #include "sim/sequence/render_job.h"
 #include "tests/test_util.h"
+#include "tests/track_figures.h"
 
 namespace irbench {
 namespace {
 namespace fs = std::filesystem;
+using irbench::testing::ReadJsonLines;
 using nlohmann::json;
 using irbench::testing::FreshTempDir;
 using irbench::testing::WriteText;
-
-std::vector<json> ReadLines(const fs::path& path) {
-  std::vector<json> lines;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) lines.push_back(json::parse(line));
-  return lines;
-}
 
 json ReadJson(const fs::path& path) {
   std::ifstream in(path);
@@ -85,7 +80,7 @@ TEST_F(DatasetExportTest, CocoKeypointsPassTheFormatsRulesAndHoldTheTruth) {
   options.format = DatasetFormat::kCoco;
   const fs::path out = RunDatasetExport(options);
   const json coco = ReadJson(out / "annotations" / "person_keypoints.json");
-  const std::vector<json> truth = ReadLines(*seq_ / "truth/frames.jsonl");
+  const std::vector<json> truth = ReadJsonLines(*seq_ / "truth/frames.jsonl");
 
   // Categories: one person category with 17 named keypoints and a skeleton
   // over them (1-based).
@@ -170,7 +165,7 @@ TEST_F(DatasetExportTest, EasyMocapReadsBackThroughOpenCvWithTheSameCameras) {
   options.out = *dir_ / "easymocap";
   options.format = DatasetFormat::kEasyMocap;
   const fs::path out = RunDatasetExport(options);
-  const std::vector<json> truth = ReadLines(*seq_ / "truth/frames.jsonl");
+  const std::vector<json> truth = ReadJsonLines(*seq_ / "truth/frames.jsonl");
 
   cv::FileStorage intri((out / "intri.yml").string(), cv::FileStorage::READ);
   cv::FileStorage extri((out / "extri.yml").string(), cv::FileStorage::READ);

@@ -15,10 +15,12 @@
 #include "sim/sequence/render_job.h"
 #include "sequence_format/manifest.h"
 #include "tests/test_util.h"
+#include "tests/track_figures.h"
 
 namespace irbench {
 namespace {
 namespace fs = std::filesystem;
+using irbench::testing::ReadJsonLines;
 using irbench::testing::FreshTempDir;
 using irbench::testing::ReadText;
 using irbench::testing::WriteText;
@@ -31,14 +33,6 @@ nlohmann::json ExactSensor(const nlohmann::json& flicker, const nlohmann::json& 
             {"dark_current_e_per_s", 0.0}}},
           {"flicker", flicker},
           {"capture", capture}};
-}
-
-std::vector<nlohmann::json> ReadLines(const fs::path& path) {
-  std::vector<nlohmann::json> lines;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) lines.push_back(nlohmann::json::parse(line));
-  return lines;
 }
 
 // An empty theater stage (background frames) whose side camera sees both the
@@ -60,7 +54,7 @@ TEST(IlluminationTest, ScreenContentAndIlluminatorsFlickerApart) {
   options.screen_sweep = false;  // the content's own flicker, not the calibration sweep
   options.out = dir / "seq";
   const fs::path seq = RunRenderJob(options);
-  const std::vector<nlohmann::json> truth = ReadLines(seq / "truth/background.jsonl");
+  const std::vector<nlohmann::json> truth = ReadJsonLines(seq / "truth/background.jsonl");
   ASSERT_EQ(truth.size(), 40u);
   Eigen::MatrixXd a(40, 2);
   Eigen::VectorXd mean(40), recorded(40);
@@ -107,7 +101,7 @@ TEST(IlluminationTest, EmptyStageFramesSweepTheScreens) {
     options.out = dir / sensor;
     const fs::path seq = RunRenderJob(options);
     const nlohmann::json manifest = ReadManifest(seq).json;
-    const std::vector<nlohmann::json> truth = ReadLines(seq / "truth/background.jsonl");
+    const std::vector<nlohmann::json> truth = ReadJsonLines(seq / "truth/background.jsonl");
     ASSERT_EQ(truth.size(), 3u);
     const bool sweep = sensor != "clean";
     if (sweep) {
