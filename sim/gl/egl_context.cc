@@ -19,12 +19,13 @@ std::string EglErrorString(EGLint error) {
   return buffer;
 }
 
-// The first EGL device that is not Mesa's software renderer, or null.
-EGLDeviceEXT FirstHardwareDevice(std::string* seen) {
+// The first EGL device, or with `hardware_only` the first that is not Mesa's
+// software renderer; null when there is none, with what was found in `seen`.
+EGLDeviceEXT FirstDevice(bool hardware_only, std::string* seen) {
   auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
   auto query_string =
       reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
-  if (query_devices == nullptr || query_string == nullptr) {
+  if (query_devices == nullptr || (hardware_only && query_string == nullptr)) {
     *seen = "no EGL_EXT_device_enumeration";
     return nullptr;
   }
@@ -33,11 +34,12 @@ EGLDeviceEXT FirstHardwareDevice(std::string* seen) {
   if (!query_devices(16, devices, &count)) count = 0;
   *seen = std::to_string(count) + " EGL device(s)";
   for (EGLint i = 0; i < count; ++i) {
+    if (!hardware_only) return devices[i];
     const char* extensions = query_string(devices[i], EGL_EXTENSIONS);
     const std::string ext = extensions != nullptr ? extensions : "";
     if (ext.find("EGL_MESA_device_software") == std::string::npos) return devices[i];
   }
-  *seen += ", all software";
+  if (hardware_only) *seen += ", all software";
   return nullptr;
 }
 
@@ -50,31 +52,21 @@ class EglHeadlessContext final : public GlContext {
       throw RuntimeError("eglGetPlatformDisplayEXT is missing (no EGL_EXT_platform_base)");
     }
     EGLint major = 0, minor = 0;
-    if (hardware_only) {
-      // The GPU path: the device platform on the first hardware device.
-      std::string seen;
-      EGLDeviceEXT device = FirstHardwareDevice(&seen);
-      if (device == nullptr) throw RuntimeError("no GPU among the EGL devices (" + seen + ")");
-      display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
-      if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-        throw RuntimeError("eglInitialize on the GPU's EGL device failed: " + EglErrorString(eglGetError()));
-      }
-    } else {
-      // Surfaceless first (Mesa); then the default device platform (vendor EGL).
+    // Mesa's surfaceless platform first, unless a GPU is asked for; then
+    // the device platform on the first (hardware) EGL device.
+    if (!hardware_only) {
       display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      if (display_ != EGL_NO_DISPLAY && !eglInitialize(display_, &major, &minor)) display_ = EGL_NO_DISPLAY;
+    }
+    if (display_ == EGL_NO_DISPLAY) {
+      std::string seen;
+      EGLDeviceEXT device = FirstDevice(hardware_only, &seen);
+      if (device == nullptr && hardware_only) throw RuntimeError("no GPU among the EGL devices (" + seen + ")");
+      if (device != nullptr) display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
       if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-        // A vendor driver: the first EGL device.
-        auto query_devices =
-            reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
-        EGLDeviceEXT device = nullptr;
-        EGLint num_devices = 0;
-        display_ = EGL_NO_DISPLAY;
-        if (query_devices != nullptr && query_devices(1, &device, &num_devices) && num_devices > 0) {
-          display_ = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
-        }
-        if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-          throw RuntimeError("eglInitialize failed: " + EglErrorString(eglGetError()));
-        }
+        throw RuntimeError(std::string(hardware_only ? "eglInitialize on the GPU's EGL device failed: "
+                                                     : "eglInitialize failed: ") +
+                           EglErrorString(eglGetError()));
       }
     }
     const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE,
