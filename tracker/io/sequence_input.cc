@@ -67,6 +67,13 @@ fs::path VideoOf(const fs::path& folder, const std::string& camera) {
   return found;
 }
 
+// "<what> is WxH, calibration says WxH" when `size` is not the camera's; "".
+std::string SizeMismatch(const std::string& what, cv::Size size, const Camera& cam) {
+  if (size.width == cam.width && size.height == cam.height) return "";
+  return what + " is " + std::to_string(size.width) + "x" + std::to_string(size.height) + ", calibration says " +
+         std::to_string(cam.width) + "x" + std::to_string(cam.height);
+}
+
 // 8-bit grey from a decoded video frame (FFmpeg hands grey videos back as BGR
 // with equal channels, which this keeps exactly).
 cv::Mat GreyOf(const cv::Mat& decoded) {
@@ -194,10 +201,8 @@ void SequenceInput::OpenVideos(SequenceInput& in, const SequenceInputOptions& op
         throw InputError(video.path.string(), "fps", "the video gives no frame rate");
       }
       in.timing_[c].fps = video.fps;
-    } else if (video.size.width != cam.width || video.size.height != cam.height) {
-      throw InputError(video.path.string(), "",
-                       "video is " + std::to_string(video.size.width) + "x" + std::to_string(video.size.height) +
-                           ", calibration says " + std::to_string(cam.width) + "x" + std::to_string(cam.height));
+    } else if (const std::string problem = SizeMismatch("video", video.size, cam); !problem.empty()) {
+      throw InputError(video.path.string(), "", problem);
     }
   }
   in.frame_count_ = in.videos_[0]->count;
@@ -305,11 +310,8 @@ cv::Mat SequenceInput::Load(const fs::path& path, int camera) const {
   cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (image.empty()) throw InputError(path.string(), "", "unreadable image");
   if (image.channels() != 1) throw InputError(path.string(), "", "expected a single-channel (grey) image");
-  const Camera& cam = cameras_.at(camera);
-  if (image.cols != cam.width || image.rows != cam.height) {
-    throw InputError(path.string(), "",
-                     "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                         ", calibration says " + std::to_string(cam.width) + "x" + std::to_string(cam.height));
+  if (const std::string problem = SizeMismatch("image", image.size(), cameras_.at(camera)); !problem.empty()) {
+    throw InputError(path.string(), "", problem);
   }
   if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
   if (image.depth() != CV_8U) throw InputError(path.string(), "", "expected 8- or 16-bit pixels");
@@ -323,12 +325,11 @@ cv::Mat SequenceInput::LoadVideoFrame(Video& video, int index, int camera) const
   } catch (const cv::Exception& e) {
     throw InputError(video.path.string(), "", "frame " + std::to_string(index) + " cannot be decoded: " + e.msg);
   }
-  const Camera& cam = cameras_.at(camera);
-  if (image.cols != cam.width || image.rows != cam.height || image.depth() != CV_8U) {
-    throw InputError(video.path.string(), "", "frame " + std::to_string(index) + " is not a " +
-                                                  std::to_string(cam.width) + "x" + std::to_string(cam.height) +
-                                                  " 8-bit image");
+  const std::string frame = "frame " + std::to_string(index);
+  if (const std::string problem = SizeMismatch(frame, image.size(), cameras_.at(camera)); !problem.empty()) {
+    throw InputError(video.path.string(), "", problem);
   }
+  if (image.depth() != CV_8U) throw InputError(video.path.string(), "", frame + " is not 8-bit");
   return image;
 }
 

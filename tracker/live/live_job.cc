@@ -69,8 +69,9 @@ void Produce(const SequenceInput& input, int frames, double fps, Mailbox& box) {
 double Percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0;
   std::sort(values.begin(), values.end());
-  const size_t i = std::min(values.size() - 1, static_cast<size_t>(std::ceil(q * values.size())) - (q > 0 ? 1 : 0));
-  return values[i];
+  // Nearest rank: the smallest value with at least a share q at or below it.
+  const size_t rank = std::clamp<size_t>(static_cast<size_t>(std::ceil(q * values.size())), 1, values.size());
+  return values[rank - 1];
 }
 
 }  // namespace
