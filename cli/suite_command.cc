@@ -27,9 +27,15 @@ int RunSuiteCommand(const CLI::App& cmd, SuiteArgs& args) {
   suite.cache = args.cache;
   const SuiteResult r = RunSuite(suite);
   std::cout << "# suite " << r.name << (suite.bless ? " (blessed)" : "") << "\n"
-            << r.Table() << "\nreports:\n";
+            << r.Table() << "\n## pooled (cm; all samples of the scenarios in a row)\n"
+            << r.PooledTable() << "\nreports:\n";
   for (const auto& [scenario, report] : r.reports)
     std::cout << "  " << scenario << "  " << report.string() << "\n";
+  std::cout << "summary: " << (r.summary / "report.html").string() << "\n";
+  if (!r.skipped.empty()) {
+    std::cout << "\nskipped (optional, data absent):\n";
+    for (const auto& [scenario, why] : r.skipped) std::cout << "  " << scenario << "  " << why << "\n";
+  }
   if (!r.pass) {
     int failed = 0;
     for (const auto& row : r.rows) failed += !row.pass;

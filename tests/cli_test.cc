@@ -633,6 +633,43 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   ASSERT_NE(listed, std::string::npos) << ok.out;
   const size_t from = listed + std::string("  p1_flap_both  ").size();
   EXPECT_TRUE(fs::exists(ok.out.substr(from, ok.out.find('\n', from) - from))) << ok.out;
+  // The pooled table (library motions; the CMU clip when ../shared has it)
+  // and the suite's own summary page linking each scenario's report.
+  EXPECT_NE(ok.out.find("| library | all | 2 |"), std::string::npos) << ok.out;
+  const bool cmu = !irbench::testing::CmuClips().empty();
+  EXPECT_EQ(ok.out.find("| mocap | all | 1 |") != std::string::npos, cmu) << ok.out;
+  EXPECT_EQ(ok.out.find("p3_cmu141_16  no motion file") != std::string::npos, !cmu) << ok.out;
+  const std::string summary = ReadText(dir / "cache" / "suite-smoke" / "report.html");
+  EXPECT_NE(summary.find("<a href=\"../p1_flap_both-"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("<th>motion</th><th>person</th>"), std::string::npos) << summary;
+
+  // A suite that includes another and adds an optional scenario whose clip is
+  // absent: the included scenarios run from the cache, the absent one is
+  // skipped and said so.
+  WriteText(dir / "inc.json", R"({"format": "irbench.suite/1", "name": "inc", "include": ["smoke"], "scenarios": [
+    {"name": "gone", "motion": "no/such/clip.bvh", "optional": true, "max_seconds": 2,
+     "thresholds": {"root_mean_cm": {"max": 10}}}]})");
+  const Result inc = RunIrbench({"suite", "run", (dir / "inc.json").string(), "--cache", (dir / "cache").string(),
+                                 "--baselines", (fs::path(IRBENCH_SOURCE_DIR) / "ci" / "baselines").string()},
+                                dir);
+  EXPECT_EQ(inc.exit_code, 0) << inc.out << inc.err;
+  EXPECT_NE(inc.out.find("| p4_direct_traffic | root_mean_cm |"), std::string::npos) << inc.out;
+  EXPECT_NE(inc.out.find("  gone  no motion file " + (dir / "no/such/clip.bvh").lexically_normal().string()),
+            std::string::npos)
+      << inc.out;
+  WriteText(dir / "cycle.json", R"({"format": "irbench.suite/1", "name": "c", "include": ["cycle.json"],
+    "scenarios": []})");
+  const Result cycle = RunIrbench({"suite", "run", (dir / "cycle.json").string(), "--cache", (dir / "cache").string()},
+                                  dir);
+  EXPECT_EQ(cycle.exit_code, 2) << cycle.err;
+  EXPECT_NE(cycle.err.find("cycle.json: include[0]: includes"), std::string::npos) << cycle.err;
+  WriteText(dir / "both.json", R"({"format": "irbench.suite/1", "name": "b", "scenarios": [
+    {"name": "a", "frames": 4, "max_seconds": 2}]})");
+  const Result both = RunIrbench({"suite", "run", (dir / "both.json").string(), "--cache", (dir / "cache").string()},
+                                 dir);
+  EXPECT_EQ(both.exit_code, 2) << both.err;
+  EXPECT_NE(both.err.find("both.json: scenarios[0].max_seconds: give frames or max_seconds"), std::string::npos)
+      << both.err;
 
   auto degraded = nlohmann::json::parse(ReadText(smoke));
   for (auto& scenario : degraded["scenarios"]) {

@@ -25,19 +25,8 @@ namespace {
 
 using Json = nlohmann::json;
 
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string Escape(const std::string& s) { return HtmlEscape(s); }
+
 
 std::string Base64(const std::string& bytes) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -569,6 +558,51 @@ ReportResult WriteReport(const Score& score, const ReportOptions& options, const
        << "<script>" << kScript << "</script>\n</body>\n</html>\n";
   AtomicWriteFile(dir / "report.html", html.str());
   return result;
+}
+
+std::string HtmlEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string MarkdownTableHtml(const std::string& markdown) {
+  std::istringstream lines(markdown);
+  std::ostringstream out;
+  out << "<table>";
+  int row = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.size() < 2 || line.front() != '|') continue;
+    if (row++ == 1) continue;  // the |---| row
+    std::vector<std::string> cells;
+    for (size_t a = 1, b; (b = line.find('|', a)) != std::string::npos; a = b + 1) {
+      std::string cell = line.substr(a, b - a);
+      cell.erase(0, cell.find_first_not_of(' '));
+      cell.erase(cell.find_last_not_of(' ') + 1);
+      cells.push_back(cell);
+    }
+    out << "<tr>";
+    for (const std::string& cell : cells) {
+      std::string html = HtmlEscape(cell);
+      for (size_t at; (at = html.find("**")) != std::string::npos;) {
+        const size_t end = html.find("**", at + 2);
+        if (end == std::string::npos) break;
+        html = html.substr(0, at) + "<b>" + html.substr(at + 2, end - at - 2) + "</b>" + html.substr(end + 2);
+      }
+      out << (row == 1 ? "<th>" : "<td>") << html << (row == 1 ? "</th>" : "</td>");
+    }
+    out << "</tr>\n";
+  }
+  out << "</table>\n";
+  return out.str();
 }
 
 }  // namespace irbench

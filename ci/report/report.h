@@ -29,6 +29,13 @@ struct ReportResult {
   std::string note;    // why there are no plots
 };
 
+// `s` with &, <, > and " as HTML entities.
+std::string HtmlEscape(const std::string& s);
+
+// A Markdown table (a header row, a |---| row, body rows) as an HTML table:
+// cells escaped, **bold** kept as <b>.
+std::string MarkdownTableHtml(const std::string& markdown);
+
 // Writes `dir`/report.html and `dir`/plots/ (the SVGs with their gnuplot data
 // and script). Throws InputError for an unreadable calibration or truth,
 // RuntimeError when gnuplot fails.

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "ci/report/report.h"
 #include "ci/score/score.h"
 #include "ci/score/score_job.h"
 #include "common/atomic_file.h"
@@ -36,7 +37,10 @@ struct Bound {
 
 struct Scenario {
   std::string name;
+  std::string suite_file;  // the file that lists it (a suite or one it includes)
   RenderJobOptions render;
+  bool optional = false;  // skipped, with a warning, when its motion file is absent
+  std::string missing;    // why it is skipped; empty: it runs
   TrackerSettings tracker;  // the scenario's `track` object: keys of TrackSettings()
   std::map<std::string, Bound> thresholds;
 };
@@ -74,32 +78,85 @@ void ReadTrackerSettings(const JsonNode& t, const fs::path& suite_file, TrackerS
   }
 }
 
-std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
+fs::path FindSuiteFile(const fs::path& suite) {
+  return fs::is_regular_file(suite) ? suite : ResolveDataFile("ci/suites", suite.string(), "SUITE");
+}
+
+// A scenario's motion: a library or motions/ name as it stands; a motion file
+// (a path with a folder or an extension) relative to the suite file's folder.
+std::string ScenarioMotion(const std::string& motion, const fs::path& suite_file) {
+  const fs::path as_path(motion);
+  const bool looks_like_path = motion.find('/') != std::string::npos || as_path.has_extension();
+  if (!looks_like_path || as_path.is_absolute()) return motion;
+  return (suite_file.parent_path() / as_path).lexically_normal().string();
+}
+
+void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vector<Scenario>* out);
+
+// `include`: the scenarios of other suites (names in ci/suites/ or files
+// relative to this one), in order, before this suite's own.
+void ReadIncludes(const JsonNode& list, const fs::path& file, std::vector<fs::path>* chain,
+                  std::vector<Scenario>* out) {
+  for (size_t i = 0; i < list.Size(); ++i) {
+    const std::string name = list[i].String();
+    fs::path other = name;
+    if (other.has_extension() || name.find('/') != std::string::npos) {
+      other = file.parent_path() / other;
+      if (!fs::is_regular_file(other)) list[i].Fail("no such suite file '" + other.string() + "'");
+    } else {
+      other = file.parent_path() / (name + ".json");
+      if (!fs::is_regular_file(other)) other = FindSuiteFile(name);
+    }
+    for (const fs::path& seen : *chain) {
+      if (fs::weakly_canonical(seen) == fs::weakly_canonical(other)) {
+        list[i].Fail("includes '" + other.string() + "' again (a cycle)");
+      }
+    }
+    ReadSuiteFile(other, chain, out);
+  }
+}
+
+void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vector<Scenario>* out) {
+  chain->push_back(file);
   const JsonNode root = ParseJsonFile(file.string());
-  root.CheckKeys({"format", "name", "description", "scenarios"});
+  root.CheckKeys({"format", "name", "description", "include", "scenarios"});
   if (root.GetString("format") != "irbench.suite/1") root["format"].Fail("expected \"irbench.suite/1\"");
-  *name = root.GetString("name", file.stem().string());
-  std::vector<Scenario> out;
+  if (root.Has("include")) ReadIncludes(root["include"], file, chain, out);
   const JsonNode list = root["scenarios"];
-  if (list.Size() == 0) list.Fail("no scenarios");
+  if (list.Size() == 0 && !root.Has("include")) list.Fail("no scenarios");
   for (size_t i = 0; i < list.Size(); ++i) {
     const JsonNode s = list[i];
-    s.CheckKeys({"name", "scene", "rig", "avatar", "motion", "sensor", "seed", "frames", "background_frames",
-                 "background_screen_sweep", "track", "thresholds"});
+    s.CheckKeys({"name", "scene", "rig", "avatar", "motion", "optional", "max_seconds", "sensor", "seed", "frames",
+                 "background_frames", "background_screen_sweep", "track", "thresholds"});
     Scenario sc;
     sc.name = s.GetString("name");
-    for (const Scenario& other : out) {
-      if (other.name == sc.name) s["name"].Fail("'" + sc.name + "' appears twice");
+    sc.suite_file = file.string();
+    for (const Scenario& other : *out) {
+      if (other.name == sc.name) s["name"].Fail("'" + sc.name + "' appears twice (also in " + other.suite_file + ")");
     }
     sc.render.scene = s.GetString("scene", "");
     sc.render.rig = s.GetString("rig", "theater4");
     sc.render.avatar = s.GetString("avatar", "p1");
-    sc.render.motion = s.GetString("motion", "demo");
+    sc.render.motion = ScenarioMotion(s.GetString("motion", "demo"), file);
+    sc.optional = s.GetBool("optional", false);
+    if (sc.optional && !fs::is_regular_file(sc.render.motion)) {
+      sc.missing = "no motion file " + sc.render.motion;
+    }
     sc.render.sensor = s.GetString("sensor", "thesis");
     sc.render.seed = static_cast<uint64_t>(s.GetInt("seed", 1));
+    if (s.Has("frames") && s.Has("max_seconds")) s["max_seconds"].Fail("give frames or max_seconds, not both");
     if (s.Has("frames")) {
       sc.render.frames = s.GetInt("frames");
       if (*sc.render.frames < 1) s["frames"].Fail("must be at least 1");
+    }
+    if (s.Has("max_seconds")) {
+      const double max_s = s.GetDouble("max_seconds");
+      if (!(max_s > 0 && max_s <= 3600)) s["max_seconds"].Fail("must be in (0, 3600]");
+      if (sc.missing.empty()) {
+        // The motion's own length, cut at max_seconds of the rig's frame rate.
+        const RenderInputs in = LoadRenderInputs(sc.render);
+        sc.render.frames = std::min(in.frame_count, static_cast<int>(std::floor(max_s * in.fps + 1e-9)));
+      }
     }
     sc.render.background_frames = s.GetInt("background_frames", 12);
     if (sc.render.background_frames < 2) s["background_frames"].Fail("the tracker needs at least 2");
@@ -120,8 +177,16 @@ std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
       if (bound.tolerance < 0) b["tolerance"].Fail("must be >= 0");
       sc.thresholds[metric] = bound;
     }
-    out.push_back(sc);
+    out->push_back(sc);
   }
+  chain->pop_back();
+}
+
+std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
+  *name = ParseJsonFile(file.string()).GetString("name", file.stem().string());
+  std::vector<fs::path> chain;
+  std::vector<Scenario> out;
+  ReadSuiteFile(file, &chain, &out);
   return out;
 }
 
@@ -141,7 +206,13 @@ std::vector<fs::path> ScenarioInputFiles(const RenderJobOptions& r) {
 // the contents of the files they name.
 std::string CacheKey(const RenderJobOptions& r) {
   const RenderInputs in = LoadRenderInputs(r);  // validates, resolves names to files
-  std::string key = ToolVersion() + "|" + r.rig + "|" + r.scene + "|" + r.avatar + "|" + r.motion + "|" + r.sensor +
+  // A motion given as a path by its file name: its contents are in the key,
+  // its folder is not (the same clip beside another checkout hits the same
+  // cache). Names stay as they are.
+  const fs::path motion_path(r.motion);
+  const bool motion_is_path = r.motion.find('/') != std::string::npos || motion_path.has_extension();
+  const std::string motion = motion_is_path ? motion_path.filename().string() : r.motion;
+  std::string key = ToolVersion() + "|" + r.rig + "|" + r.scene + "|" + r.avatar + "|" + motion + "|" + r.sensor +
                     "|" + std::to_string(r.seed) + "|" + std::to_string(r.frames.value_or(-1)) + "|" +
                     std::to_string(r.background_frames) + "|" + std::to_string(r.supersample) +
                     (SweepsScreens(r, in) ? "|sweep" : "");
@@ -155,9 +226,17 @@ std::string CacheKey(const RenderJobOptions& r) {
   return hex;
 }
 
-// What one scenario measured, in the order of its thresholds.
-std::map<std::string, double> RunScenario(const Scenario& sc, const std::string& suite, const fs::path& cache,
-                                          std::mutex* render_mutex, fs::path* report) {
+// What one scenario measured: its metrics and, for pooling over scenarios,
+// how many samples each metric is a mean over.
+struct Measured {
+  std::map<std::string, double> metrics;
+  std::map<std::string, double> weights;
+  std::string group;  // "library" or "mocap" (the motion's kind)
+  std::string person;
+};
+
+Measured RunScenario(const Scenario& sc, const std::string& suite, const fs::path& cache, std::mutex* render_mutex,
+                     fs::path* report) {
   const auto start = std::chrono::steady_clock::now();
   // Render, or reuse the cached frames of the same inputs. One render at a
   // time: each render job owns the process's GL display while it runs.
@@ -189,15 +268,21 @@ std::map<std::string, double> RunScenario(const Scenario& sc, const std::string&
   job.overwrite = true;
   Score score;
   *report = RunScoreJob(job, nullptr, &score) / "report.html";
-  std::map<std::string, double> metrics;
+  Measured out;
+  const std::string kind = ReadManifest(seq).json[manifest_key::kMotion].value("kind", "");
+  out.group = kind == "bvh" || kind == "amc" ? "mocap" : "library";
+  out.person = sc.render.avatar;
+  std::map<std::string, double>& metrics = out.metrics;
   metrics["silhouette_iou_median"] = score.silhouettes ? score.silhouettes->All().iou_median : 0.0;
   metrics["tracked_fraction"] = score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
+  out.weights["tracked_fraction"] = score.present_frames;
   double arms = 0;
   int arm_joints = 0;
   for (const std::string& joint : ScoredJoints()) {
     const ErrorStats& e = score.joints.at(joint);
     if (e.total == 0) continue;
     metrics[joint + "_mean_cm"] = e.mean;
+    out.weights[joint + "_mean_cm"] = e.total - e.outliers;
     if (joint.find("shoulder") != std::string::npos || joint.find("elbow") != std::string::npos ||
         joint.find("wrist") != std::string::npos) {
       arms += e.mean;
@@ -212,13 +297,63 @@ std::map<std::string, double> RunScenario(const Scenario& sc, const std::string&
     pointing += e.mean * (e.total - e.outliers);
     kept += e.total - e.outliers;
   }
-  if (kept) metrics["pointing_mean_deg"] = pointing / kept;
+  if (kept) {
+    metrics["pointing_mean_deg"] = pointing / kept;
+    out.weights["pointing_mean_deg"] = kept;
+  }
   if (const auto it = score.rest.find("both"); it != score.rest.end() && it->second.total) {
     metrics["rest_accuracy"] = it->second.rate();
+    out.weights["rest_accuracy"] = it->second.total;
   }
   Log().info("suite {}: {}: done in {:.0f} s", suite, sc.name,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  return metrics;
+  return out;
+}
+
+// The scenarios' figures pooled per group and person: each metric the mean
+// over every sample of the scenarios in the row (a scenario's mean weighted
+// by its sample count); arms the mean of the six pooled arm joints.
+std::vector<PooledRow> Pool(const std::vector<Measured>& measured) {
+  std::map<std::pair<std::string, std::string>, std::vector<const Measured*>> rows;
+  for (const Measured& m : measured) {
+    rows[{m.group, m.person}].push_back(&m);
+    rows[{m.group, "all"}].push_back(&m);
+  }
+  std::vector<PooledRow> out;
+  for (const auto& [key, members] : rows) {
+    PooledRow row;
+    row.group = key.first;
+    row.person = key.second;
+    row.scenarios = static_cast<int>(members.size());
+    std::map<std::string, std::pair<double, double>> sums;  // metric -> (sum of value x weight, weight)
+    for (const Measured* m : members) {
+      for (const auto& [metric, w] : m->weights) {
+        sums[metric].first += m->metrics.at(metric) * w;
+        sums[metric].second += w;
+      }
+    }
+    for (const auto& [metric, sw] : sums) {
+      if (sw.second > 0) row.metrics[metric] = sw.first / sw.second;
+    }
+    double arms = 0;
+    int arm_joints = 0;
+    for (const char* side : {"left_", "right_"}) {
+      for (const char* joint : {"shoulder", "elbow", "wrist"}) {
+        const auto it = row.metrics.find(std::string(side) + joint + "_mean_cm");
+        if (it == row.metrics.end()) continue;
+        arms += it->second;
+        ++arm_joints;
+      }
+    }
+    if (arm_joints) row.metrics["arms_mean_cm"] = arms / arm_joints;
+    row.frames = sums.count("tracked_fraction") ? static_cast<int>(sums["tracked_fraction"].second) : 0;
+    out.push_back(row);
+  }
+  // "all" last within each group.
+  std::stable_sort(out.begin(), out.end(), [](const PooledRow& a, const PooledRow& b) {
+    return a.group != b.group ? a.group < b.group : (a.person == "all") < (b.person == "all");
+  });
+  return out;
 }
 
 }  // namespace
@@ -233,11 +368,86 @@ std::string SuiteResult::Table() const {
   return out.str();
 }
 
+namespace {
+
+// <dir>/summary.md and <dir>/report.html: the scenarios' table, the pooled
+// table, and each scenario's own report.html linked.
+void WriteSummary(SuiteResult& result, const fs::path& dir) {
+  fs::create_directories(dir);
+  std::ostringstream md, html;
+  md << "# suite " << result.name << "\n\n" << result.Table() << "\n## pooled\n\n" << result.PooledTable();
+  html << "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>suite " << HtmlEscape(result.name)
+       << "</title><style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;margin:1em 0}"
+          "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}th{background:#eee}</style></head><body>\n"
+       << "<h1>suite " << HtmlEscape(result.name) << (result.pass ? "" : " — <b>FAILED</b>") << "</h1>\n"
+       << "<h2>Pooled <small>(cm; the mean over all samples of the scenarios in a row; arms: the six arm "
+          "joints)</small></h2>\n"
+       << MarkdownTableHtml(result.PooledTable()) << "<h2>Scenarios</h2>\n" << MarkdownTableHtml(result.Table())
+       << "<h2>Each scenario's report</h2>\n<ul>\n";
+  for (const auto& [scenario, report] : result.reports) {
+    const std::string link = fs::relative(report, dir).generic_string();
+    html << "<li><a href=\"" << HtmlEscape(link) << "\">" << HtmlEscape(scenario) << "</a></li>\n";
+  }
+  html << "</ul>\n";
+  if (!result.skipped.empty()) {
+    md << "\n## skipped (optional, data absent)\n\n";
+    html << "<h2>Skipped <small>(optional, data absent)</small></h2>\n<ul>\n";
+    for (const auto& [scenario, why] : result.skipped) {
+      md << "- " << scenario << ": " << why << "\n";
+      html << "<li>" << HtmlEscape(scenario) << ": " << HtmlEscape(why) << "</li>\n";
+    }
+    html << "</ul>\n";
+  }
+  html << "</body></html>\n";
+  AtomicWriteFile(dir / "summary.md", md.str());
+  AtomicWriteFile(dir / "report.html", html.str());
+  result.summary = dir;
+}
+
+}  // namespace
+
+std::string SuiteResult::PooledTable() const {
+  std::ostringstream out;
+  out << "| motion | person | scenarios | present frames | root | waist | neck | shoulders | elbows | wrists | arms | "
+         "rest | tracked |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const auto cm = [](const PooledRow& r, const std::string& m) {
+    const auto it = r.metrics.find(m);
+    return it == r.metrics.end() ? std::string("–") : Fixed(it->second, 2);
+  };
+  const auto pair = [&](const PooledRow& r, const std::string& joint) {
+    const auto l = r.metrics.find("left_" + joint + "_mean_cm"), rr = r.metrics.find("right_" + joint + "_mean_cm");
+    if (l == r.metrics.end() || rr == r.metrics.end()) return std::string("–");
+    return Fixed((l->second + rr->second) / 2, 2);
+  };
+  const auto pct = [](const PooledRow& r, const std::string& m) {
+    const auto it = r.metrics.find(m);
+    return it == r.metrics.end() ? std::string("–") : Fixed(100 * it->second, 1) + " %";
+  };
+  for (const PooledRow& r : pooled) {
+    out << "| " << r.group << " | " << r.person << " | " << r.scenarios << " | " << r.frames << " | "
+        << cm(r, "root_mean_cm") << " | " << cm(r, "waist_mean_cm") << " | " << cm(r, "neck_mean_cm") << " | "
+        << pair(r, "shoulder") << " | " << pair(r, "elbow") << " | " << pair(r, "wrist") << " | "
+        << cm(r, "arms_mean_cm") << " | " << pct(r, "rest_accuracy") << " | " << pct(r, "tracked_fraction")
+        << " |\n";
+  }
+  return out.str();
+}
+
 SuiteResult RunSuite(const SuiteRunOptions& options) {
-  fs::path file = options.suite;
-  if (!fs::is_regular_file(file)) file = ResolveDataFile("ci/suites", options.suite.string(), "SUITE");
+  const fs::path file = FindSuiteFile(options.suite);
   SuiteResult result;
-  const std::vector<Scenario> scenarios = ReadSuite(file, &result.name);
+  std::vector<Scenario> scenarios = ReadSuite(file, &result.name);
+  // Optional scenarios whose data is absent (the CMU clips beside the
+  // checkout) are skipped, said once each.
+  for (auto it = scenarios.begin(); it != scenarios.end();) {
+    if (it->missing.empty()) {
+      ++it;
+      continue;
+    }
+    Log().warn("suite {}: {}: skipped: {}", result.name, it->name, it->missing);
+    result.skipped.emplace_back(it->name, it->missing);
+    it = scenarios.erase(it);
+  }
   const fs::path baselines_dir = options.baselines.empty() ? DataRoot() / "ci" / "baselines" : options.baselines;
   const fs::path baseline_file = baselines_dir / (result.name + ".json");
   nlohmann::json baseline = nlohmann::json::object();
@@ -255,7 +465,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const size_t workers = std::min<size_t>(scenarios.size(), options.jobs > 0 ? size_t(options.jobs) : cores);
   Log().info("suite {}: {} scenario(s), {} at a time", result.name, scenarios.size(), workers);
-  std::vector<std::map<std::string, double>> measured(scenarios.size());
+  std::vector<Measured> measured(scenarios.size());
   std::vector<std::exception_ptr> errors(scenarios.size());
   std::vector<fs::path> reports(scenarios.size());
   std::atomic<size_t> next{0};
@@ -291,7 +501,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   nlohmann::json blessed = nlohmann::json::object();
   for (size_t i = 0; i < scenarios.size(); ++i) {
     const Scenario& sc = scenarios[i];
-    const std::map<std::string, double>& metrics = measured[i];
+    const std::map<std::string, double>& metrics = measured[i].metrics;
     result.reports.emplace_back(sc.name, reports[i]);
     for (const auto& [metric, bound] : sc.thresholds) {
       MetricResult r;
@@ -327,6 +537,8 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
     }
   }
   for (const MetricResult& r : result.rows) result.pass &= r.pass;
+  result.pooled = Pool(measured);
+  WriteSummary(result, cache / ("suite-" + result.name));
   if (options.bless) {
     fs::create_directories(baselines_dir);
     AtomicWriteFile(baseline_file, blessed.dump(2) + "\n");

@@ -49,12 +49,28 @@ struct MetricResult {
   std::string why;  // when it fails
 };
 
+// A suite's figures pooled over scenarios of one kind of motion ("library":
+// the motion library, keyframes, sessions; "mocap": BVH/AMC clips) and one
+// person, or all persons ("all"): every metric the mean over all samples of
+// those scenarios, arms the mean of the six pooled arm joints (cm; rest and
+// tracked as fractions).
+struct PooledRow {
+  std::string group, person;
+  int scenarios = 0;
+  int frames = 0;  // frames with the person on the stage
+  std::map<std::string, double> metrics;
+};
+
 struct SuiteResult {
   std::string name;
   std::vector<MetricResult> rows;
   std::vector<std::pair<std::string, std::filesystem::path>> reports;  // scenario -> its report.html
+  std::vector<std::pair<std::string, std::string>> skipped;          // scenario -> why (optional, data absent)
+  std::vector<PooledRow> pooled;
+  std::filesystem::path summary;  // the folder with summary.md and report.html (<cache>/suite-<name>)
   bool pass = true;
-  std::string Table() const;  // Markdown
+  std::string Table() const;        // Markdown: every scenario's metrics against thresholds and baseline
+  std::string PooledTable() const;  // Markdown: the pooled rows
 };
 
 // Throws InputError for a bad suite file (naming the file and field).
