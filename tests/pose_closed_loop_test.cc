@@ -245,5 +245,57 @@ TEST_F(PoseClosedLoopTest, RecoversWithinThreeFramesAfterTheParticlesAreScattere
   for (int r : recovery) EXPECT_LE(r, 3);
 }
 
+// A user facing away from the screen: the silhouettes look the same turned
+// round, and the screen's heading prior alone tracks CMU's wave hello
+// (141_16, which faces away from the screen) turned round throughout. The
+// feet, read off the hull, show which way the user faces. (They do not
+// always: where the floor layer is mostly the hull's phantom volume its
+// centroid can point anywhere — a library flap on p3 at heading 170 deg
+// read backwards in 7 frames of 10: docs/tracker.md.)
+TEST(PoseFacingTest, TheWaveFacingAwayFromTheScreenIsNotTurnedRound) {
+  const std::vector<fs::path> clips = irbench::testing::CmuClips();
+  const auto clip = std::find_if(clips.begin(), clips.end(), [](const fs::path& p) { return p.stem() == "141_16"; });
+  if (clip == clips.end()) GTEST_SKIP() << "no CMU clip 141_16 in ../shared/data/mocap/cmu";
+  const fs::path dir = FreshTempDir("pose_facing_" + std::to_string(getpid()));
+  RenderJobOptions options;
+  options.rig = "theater4";
+  options.avatar = "p3";
+  options.motion = clip->string();
+  options.sensor = "thesis";
+  options.background_frames = 12;
+  options.frames = 60;
+  options.seed = 3;
+  options.out = dir / "seq";
+  const fs::path seq = RunRenderJob(options);
+  std::vector<nlohmann::json> truth;
+  std::ifstream in(seq / "truth/frames.jsonl");
+  for (std::string line; std::getline(in, line);) truth.push_back(nlohmann::json::parse(line));
+  const SequenceInput input = SequenceInput::Open(seq);
+  const FrontEnd front_end = FrontEnd::Train(input, {});
+  PoseTrackerOptions feet_options, screen_options;
+  screen_options.heading_from_feet = false;
+  PoseTracker feet(input.cameras(), input.screens(), feet_options);
+  PoseTracker screen(input.cameras(), input.screens(), screen_options);
+  std::vector<double> feet_errors, screen_errors;
+  for (int f = 0; f < input.frame_count(); ++f) {
+    const FrameFeatures features = front_end.Process(f, input.FrameSet(f));
+    const PoseEstimate a = feet.Step(features, 1.0 / input.fps());
+    const PoseEstimate b = screen.Step(features, 1.0 / input.fps());
+    if (f < 5 || !truth[f]["present"].get<bool>()) continue;
+    for (const char* name : {"left_shoulder", "right_shoulder"}) {
+      const Eigen::Vector3d t = V(truth[f]["joints3d"][name]);
+      if (a.tracking) feet_errors.push_back((a.body.joints[ModelIndex(name)] - t).norm());
+      if (b.tracking) screen_errors.push_back((b.body.joints[ModelIndex(name)] - t).norm());
+    }
+  }
+  std::printf("shoulders: %.1f cm with the feet, %.1f cm facing the screen (%zu, %zu samples)\n",
+              Mean(feet_errors) * 100, Mean(screen_errors) * 100, feet_errors.size(), screen_errors.size());
+  ASSERT_GT(feet_errors.size(), 80u);
+  // Turned round, the shoulders are a shoulder width off (about 35 cm).
+  EXPECT_LT(Mean(feet_errors), 0.08);
+  EXPECT_GT(Mean(screen_errors), 0.2);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace irbench

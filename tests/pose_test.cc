@@ -14,6 +14,7 @@
 #include "common/cancel.h"
 #include "common/error.h"
 #include "sim/camera/rig.h"
+#include "tracker/pose/hull_legs.h"
 #include "tracker/pose/icp.h"
 #include "tracker/pose/particle_filter.h"
 #include "tracker/pose/observation.h"
@@ -416,6 +417,77 @@ TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
   PoseTrackerOptions tracker_options;
   tracker_options.hull_head.radius_m = -1;
   EXPECT_THROW(tracker_options.Check(), InputError);
+}
+
+
+// The root is read off the hull's lower legs: two shins leaning forward (the
+// knees 12 cm ahead of the ankles, as people stand), feet reaching forward
+// of the ankles, a person facing 30 deg from +y. The layers' line
+// extrapolated to the ankles' height is the ankles' midpoint, not the point
+// under the knees or the waist; the feet give the facing direction.
+TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
+  VoxelHull hull = EmptyStageHull();
+  const double height = 1.75;
+  HullLegsOptions options;
+  const double ankle_z = options.ankle * height;
+  const Eigen::Vector2d forward(std::sin(M_PI / 6), std::cos(M_PI / 6));
+  const Eigen::Vector2d side(forward.y(), -forward.x());
+  const Eigen::Vector2d mid(0.13, -0.21);
+  const auto on_leg = [&](const Vector3d& c, const Eigen::Vector2d& ankle, double lean) {
+    if (c.z() < ankle_z || c.z() > 0.5) return false;
+    const Eigen::Vector2d axis = ankle + lean * (c.z() - ankle_z) * forward;  // the shin's centre at c's height
+    return (c.head<2>() - axis).norm() < 0.055;
+  };
+  const auto on_foot = [&](const Vector3d& c, const Eigen::Vector2d& ankle) {
+    const Eigen::Vector2d d = c.head<2>() - ankle;
+    return c.z() < ankle_z && d.dot(forward) > -0.05 && d.dot(forward) < 0.19 && std::abs(d.dot(side)) < 0.045;
+  };
+  const Eigen::Vector2d right = mid + 0.11 * side + 0.06 * forward, left = mid - 0.11 * side - 0.06 * forward;
+  const double lean = 0.12 / (0.5 - ankle_z);
+  FillHull(&hull, [&](const Vector3d& c) {
+    return on_leg(c, right, lean) || on_leg(c, left, lean) || on_foot(c, right) || on_foot(c, left);
+  });
+  const Vector3d model_root(mid.x() + 0.1 * forward.x(), mid.y() + 0.1 * forward.y(), 0);  // under the waist
+  const Vector3d facing(forward.x(), forward.y(), 0.3);  // need not be unit or level
+  options.calf = 0;
+  options.weight = 1;
+  const auto legs = MeasureHullLegs(hull, model_root, facing, height, options);
+  ASSERT_TRUE(legs);
+  EXPECT_NEAR((legs->root.head<2>() - mid).norm(), 0.0, 0.01);  // half a 2 cm voxel
+  EXPECT_EQ(legs->root.z(), 0.0);
+  EXPECT_GE(legs->layers, options.min_layers);
+  ASSERT_TRUE(legs->toes);
+  EXPECT_GT(legs->toes->dot(forward), 0.05);
+  EXPECT_LT(std::abs(legs->toes->dot(side)), 0.01);
+  // The calf correction moves the root forward by that share of the height.
+  options.calf = 0.0085;
+  const auto corrected = MeasureHullLegs(hull, model_root, facing, height, options);
+  ASSERT_TRUE(corrected);
+  EXPECT_NEAR((corrected->root.head<2>() - legs->root.head<2>() - 0.0085 * height * forward).norm(), 0.0, 1e-9);
+  // Blended with the model's root: that share of the way from it.
+  options.weight = 0.8;
+  const auto blended = MeasureHullLegs(hull, model_root, facing, height, options);
+  ASSERT_TRUE(blended);
+  EXPECT_NEAR((blended->root - (model_root + 0.8 * (corrected->root - model_root))).norm(), 0.0, 1e-9);
+  // A lean steeper than max_lean is carried down only that far: the shins'
+  // 0.29 capped at 0.1 leaves the root ahead of the ankles (towards the
+  // knees) by 0.19 times the anchor layers' height above the ankles.
+  options.weight = 1;
+  options.calf = 0;
+  options.max_lean = 0.1;
+  const auto capped = MeasureHullLegs(hull, model_root, facing, height, options);
+  ASSERT_TRUE(capped);
+  EXPECT_GT((capped->root.head<2>() - mid).dot(forward), 0.01);
+  options.max_lean = 0.3;
+
+  // No legs near the model's root, an empty hull, legs leaning more than
+  // max_slope: the model's root stands.
+  EXPECT_FALSE(MeasureHullLegs(hull, model_root + Vector3d(0.8, 0, 0), facing, height, options));
+  EXPECT_FALSE(MeasureHullLegs(EmptyStageHull(), model_root, facing, height, options));
+  options.max_slope = 0.2;
+  EXPECT_FALSE(MeasureHullLegs(hull, model_root, facing, height, options));
+  options.low = 0.3;
+  EXPECT_THROW(options.Check(), InputError);
 }
 
 }  // namespace

@@ -72,6 +72,13 @@ std::vector<TrackSetting> MakeSettings() {
                              [](TrackerSettings& t, const std::string& v) {
                                t.frontend.background.model = *ParseBackgroundKind(v);
                              }}});
+  s.push_back({"root_from_hull", "--root-from-model",
+               "pose: report the model's root (under its waist) instead of the one measured on the\n"
+               "hull's lower legs",
+               BoolBinding{[](TrackerSettings& t) -> bool& { return t.pose.root_from_hull; }, false}});
+  s.push_back({"heading_from_feet", "--heading-from-screen",
+               "pose: a standing user is taken to face the screens, not the way the hull's feet point",
+               BoolBinding{[](TrackerSettings& t) -> bool& { return t.pose.heading_from_feet; }, false}});
   s.push_back(
       {"remove_shadows", "--keep-shadows", "skip the edge-based shadow removal",
        BoolBinding{[](TrackerSettings& t) -> bool& { return t.frontend.remove_shadows; }, false}});

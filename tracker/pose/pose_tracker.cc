@@ -67,14 +67,31 @@ bool PoseTracker::InView(const Eigen::Vector3d& root) const {
   return true;
 }
 
+Vector2d PoseTracker::Preferred() const {
+  if (options_.heading_from_feet && feet_toes_.norm() >= std::max(options_.feet_min_m, 1e-6)) {
+    return feet_toes_.normalized();
+  }
+  return facing_xy_;
+}
+
+void PoseTracker::MeasureLegs(const FrameFeatures& features, double dt, PoseEstimate* out) {
+  if (!out->tracking || !features.voxels) return;
+  const auto legs = MeasureHullLegs(*features.voxels, out->body.joints[kModelRoot],
+                                    out->body.frames[kLowerBody].linear() * Vector3d::UnitY(), shape_.height_m,
+                                    options_.hull_legs);
+  if (legs && options_.root_from_hull) out->body.joints[kModelRoot] = legs->root;
+  const double keep = std::exp(-dt / options_.feet_memory_s);
+  feet_toes_ = keep * feet_toes_ + (1 - keep) * (legs && legs->toes ? *legs->toes : Vector2d::Zero());
+}
+
 double PoseTracker::HeadingPrior(const BodyPose& pose) const {
   auto away = [&](const Vector2d& dir) { return (1.0 - std::cos(pose.dof[kDofYaw] - YawFacing(dir))) / 2; };
   if (walking_) return -options_.walking_heading_prior * away(velocity_xy_.normalized());
   if (walk_memory_ > 0) {
-    const Vector2d blend = walk_memory_ * walk_dir_ + (1 - walk_memory_) * facing_xy_;
+    const Vector2d blend = walk_memory_ * walk_dir_ + (1 - walk_memory_) * Preferred();
     if (blend.norm() > 1e-3) return -options_.screen_heading_prior * away(blend.normalized());
   }
-  return -options_.screen_heading_prior * away(facing_xy_);
+  return -options_.screen_heading_prior * away(Preferred());
 }
 
 double PoseTracker::Evaluate(const BodyShape& shape, const BodyPose& pose, const std::vector<SilhouetteView>& views,
@@ -111,13 +128,7 @@ void PoseTracker::Initialise(const FrameFeatures& features) {
   const BodyPlacement& place = *features.placement;
   shape_ = calibration_.Start(place.top_m);
   const Vector2d root = place.root.head<2>();
-  Vector2d to_screen = facing_xy_;
-  std::normal_distribution<double> yaw_noise(0.0, 0.3), pos_noise(0.0, 0.03);
-  particles_.clear();
-  // Half face the screen; half face the stage's centre, where a user who
-  // has just walked in is heading.
   const Vector2d to_centre = -root;
-  const double yaw_centre = to_centre.norm() > 0.5 ? YawFacing(to_centre.normalized()) : YawFacing(to_screen);
   // First seen half in view: entering, heading for the centre.
   walk_memory_ = 0;
   entering_ = false;
@@ -126,6 +137,22 @@ void PoseTracker::Initialise(const FrameFeatures& features) {
     walk_memory_ = 1;
     entering_ = true;
   }
+  // A user standing in view at once: the feet tell which way they face
+  // (averaged from here on by MeasureLegs). Without this first reading the
+  // mocap suite's arms were 17.50 cm against 17.15, CMU 141_16's shoulders
+  // 10.1 against 4.0 cm.
+  feet_toes_ = Vector2d::Zero();
+  if (features.voxels && !entering_) {
+    const auto legs = MeasureHullLegs(*features.voxels, place.root, Vector3d(facing_xy_.x(), facing_xy_.y(), 0),
+                                      shape_.height_m, options_.hull_legs);
+    if (legs && legs->toes) feet_toes_ = *legs->toes;
+  }
+  const Vector2d to_screen = Preferred();
+  std::normal_distribution<double> yaw_noise(0.0, 0.3), pos_noise(0.0, 0.03);
+  particles_.clear();
+  // Half face the screen (or where the feet point); half face the stage's
+  // centre, where a user who has just walked in is heading.
+  const double yaw_centre = to_centre.norm() > 0.5 ? YawFacing(to_centre.normalized()) : YawFacing(to_screen);
   for (int i = 0; i < options_.particles; ++i) {
     const double yaw = (i % 4 < 2 ? YawFacing(to_screen) : yaw_centre) + yaw_noise(rng_);
     BodyPose p = (i % 2 == 0) ? StandingPose(shape_, root, yaw) : ScarecrowPose(shape_, root, yaw);
@@ -242,7 +269,7 @@ std::vector<BodyPose> PoseTracker::ProposeParticles(const FrameFeatures& feature
                                   .features = features,
                                   .arm_chains = arm_chains_,
                                   .torso_xy = torso_xy_,
-                                  .facing_xy = facing_xy_,
+                                  .facing_xy = Preferred(),
                                   .velocity_xy = velocity_xy_,
                                   .walk_dir = walk_dir_,
                                   .walking = walking_,
@@ -463,6 +490,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   out.body = PoseBody(shape_, out.pose);
   if (!out.tracking) lifted_age_s_ = {kNever, kNever};
   if (out.tracking && rest_ && !rest_->empty()) DecideRest(proposed, log_likelihood, best, views, dt, &out);
+  MeasureLegs(features, dt, &out);
   HeadAndPointing(features, views, &out);
 
   // Resampling (systematic), carrying each particle's previous state along

@@ -137,6 +137,14 @@ class PoseTracker {
   PoseProposalHook hook_;
   std::shared_ptr<const RestClassifier> rest_;
   Eigen::Vector2d facing_xy_ = Eigen::Vector2d::UnitY();
+  // The feet's direction (HullLegs::toes), averaged over feet_memory_s; zero
+  // before the feet are seen.
+  Eigen::Vector2d feet_toes_ = Eigen::Vector2d::Zero();
+  // The direction a standing user is taken to face: the feet's when they
+  // show it (heading_from_feet), else the screens'.
+  Eigen::Vector2d Preferred() const;
+  // The root from the hull's legs (root_from_hull) and the feet's direction.
+  void MeasureLegs(const FrameFeatures& features, double dt, PoseEstimate* out);
 
   bool active_ = false;
   BodyShape shape_;

@@ -47,6 +47,9 @@ void PoseTrackerOptions::Check() const {
                      "must be at least pose.rest_seen_max_angle_deg");
   }
   hull_head.Check();
+  hull_legs.Check();
+  if (!(feet_memory_s > 0)) throw InputError("", "pose.feet_memory_s", "must be positive");
+  if (!(feet_min_m >= 0)) throw InputError("", "pose.feet_min_m", "must be non-negative");
   if (height_frames < 1) throw InputError("", "pose.height_frames", "must be at least 1");
   if (arm_thickness_frames < 0)
     throw InputError("", "pose.arm_thickness_frames", "must be non-negative");

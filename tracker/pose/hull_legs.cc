@@ -1,0 +1,96 @@
+#include "tracker/pose/hull_legs.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <vector>
+
+#include "common/error.h"
+
+namespace irbench {
+
+void HullLegsOptions::Check() const {
+  const std::string where = "hull_legs";
+  if (!(low > 0 && high > low && high < 0.5)) throw InputError("", where + ".high", "need 0 < low < high < 0.5");
+  if (!(layer_m > 0 && layer_m < 0.2)) throw InputError("", where + ".layer_m", "must be in (0, 0.2)");
+  if (min_layers < 2) throw InputError("", where + ".min_layers", "must be at least 2");
+  if (min_layer_voxels < 1) throw InputError("", where + ".min_layer_voxels", "must be at least 1");
+  if (!(ankle >= 0 && ankle < low)) throw InputError("", where + ".ankle", "must be in [0, low)");
+  if (!(std::abs(calf) < 0.05)) throw InputError("", where + ".calf", "must be within +-0.05");
+  if (!(radius_m > 0)) throw InputError("", where + ".radius_m", "must be > 0");
+  if (!(max_slope > 0)) throw InputError("", where + ".max_slope", "must be > 0");
+  if (!(max_lean >= 0 && max_lean <= max_slope)) throw InputError("", where + ".max_lean", "must be in [0, max_slope]");
+  if (!(anchor_high > low && anchor_high <= high)) throw InputError("", where + ".anchor_high", "must be in (low, high]");
+  if (!(weight >= 0 && weight <= 1)) throw InputError("", where + ".weight", "must be in [0, 1]");
+  if (!(max_offset_m > 0)) throw InputError("", where + ".max_offset_m", "must be > 0");
+  if (!(feet > 0 && feet <= ankle + 0.02)) throw InputError("", where + ".feet", "must be in (0, ankle + 0.02]");
+  if (min_feet_voxels < 1) throw InputError("", where + ".min_feet_voxels", "must be at least 1");
+}
+
+std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vector3d& model_root,
+                                        const Eigen::Vector3d& forward, double height_m,
+                                        const HullLegsOptions& options) {
+  if (!(height_m > 0)) return std::nullopt;
+  const double low = options.low * height_m, high = options.high * height_m;
+  const int layer_count = std::max(1, static_cast<int>(std::floor((high - low) / options.layer_m)));
+  std::vector<Eigen::Vector2d> sums(layer_count, Eigen::Vector2d::Zero());
+  std::vector<int> counts(layer_count, 0);
+  Eigen::Vector2d feet_sum = Eigen::Vector2d::Zero();
+  int feet_count = 0;
+  const double r2 = options.radius_m * options.radius_m;
+  for (const Eigen::Vector3d& c : hull.OccupiedCenters()) {
+    if (c.z() >= low + layer_count * options.layer_m) continue;
+    if ((c.head<2>() - model_root.head<2>()).squaredNorm() > r2) continue;
+    if (c.z() < options.feet * height_m) {
+      feet_sum += c.head<2>();
+      ++feet_count;
+    }
+    if (c.z() < low) continue;
+    const int layer = static_cast<int>((c.z() - low) / options.layer_m);
+    if (layer < 0 || layer >= layer_count) continue;
+    sums[layer] += c.head<2>();
+    ++counts[layer];
+  }
+  // The lean: least squares of the layers' centroids against their heights,
+  // capped at max_lean. The ankles: the lowest layers' centroid carried down
+  // the lean to the ankles' height (a kink at the knee or a calf seen by
+  // fewer views bends the upper layers: the lean from them is trusted only
+  // so far).
+  const double ankle_z = options.ankle * height_m;
+  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+  Eigen::Matrix2d atb = Eigen::Matrix2d::Zero();  // columns x, y
+  Eigen::Vector2d anchor = Eigen::Vector2d::Zero();
+  double anchor_z = 0;
+  int layers = 0, anchor_layers = 0;
+  for (int i = 0; i < layer_count; ++i) {
+    if (counts[i] < options.min_layer_voxels) continue;
+    const Eigen::Vector2d centroid = sums[i] / counts[i];
+    const double z = low + (i + 0.5) * options.layer_m;
+    const Eigen::Vector2d a(1.0, z - ankle_z);
+    ata += a * a.transpose();
+    atb += a * centroid.transpose();
+    ++layers;
+    if (z < options.anchor_high * height_m) {
+      anchor += centroid;
+      anchor_z += z;
+      ++anchor_layers;
+    }
+  }
+  if (layers < options.min_layers || anchor_layers == 0 || std::abs(ata.determinant()) < 1e-12) return std::nullopt;
+  const Eigen::Matrix2d line = ata.ldlt().solve(atb);  // row 0: intercept (x, y); row 1: slope
+  Eigen::Vector2d lean = line.row(1).transpose();
+  if (lean.norm() > options.max_slope) return std::nullopt;
+  if (lean.norm() > options.max_lean) lean *= options.max_lean / lean.norm();
+  const Eigen::Vector2d ankles = anchor / anchor_layers - lean * (anchor_z / anchor_layers - ankle_z);
+  Eigen::Vector2d facing = forward.head<2>();
+  facing = facing.norm() > 1e-9 ? facing.normalized() : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d measured = ankles + options.calf * height_m * facing;
+  if ((measured - model_root.head<2>()).norm() > options.max_offset_m) return std::nullopt;
+  const Eigen::Vector2d root = model_root.head<2>() + options.weight * (measured - model_root.head<2>());
+  HullLegs out;
+  out.root = Eigen::Vector3d(root.x(), root.y(), 0.0);
+  out.layers = layers;
+  if (feet_count >= options.min_feet_voxels) out.toes = feet_sum / feet_count - ankles;
+  return out;
+}
+
+}  // namespace irbench
