@@ -636,7 +636,8 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   // The pooled table (library motions; the CMU clip when ../shared has it)
   // and the suite's own summary page linking each scenario's report.
   EXPECT_NE(ok.out.find("| library | all | 2 |"), std::string::npos) << ok.out;
-  const bool cmu = !irbench::testing::CmuClips().empty();
+  const std::vector<fs::path> clips = irbench::testing::CmuClips();
+  const bool cmu = std::any_of(clips.begin(), clips.end(), [](const fs::path& c) { return c.stem() == "141_16"; });
   EXPECT_EQ(ok.out.find("| mocap | all | 1 |") != std::string::npos, cmu) << ok.out;
   EXPECT_EQ(ok.out.find("p3_cmu141_16  no motion file") != std::string::npos, !cmu) << ok.out;
   const std::string summary = ReadText(dir / "cache" / "suite-smoke" / "report.html");
@@ -648,12 +649,21 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   // skipped and said so.
   WriteText(dir / "inc.json", R"({"format": "irbench.suite/1", "name": "inc", "include": ["smoke"], "scenarios": [
     {"name": "gone", "motion": "no/such/clip.bvh", "optional": true, "max_seconds": 2,
+     "thresholds": {"root_mean_cm": {"max": 10}}},
+    {"name": "p1_flap_lib", "avatar": "p1", "motion": "flap_both", "optional": true, "frames": 24, "seed": 1,
      "thresholds": {"root_mean_cm": {"max": 10}}}]})");
+  // Blessed: the skipped scenario keeps the figures it had.
+  fs::create_directories(dir / "inc_baselines");
+  WriteText(dir / "inc_baselines" / "inc.json", R"({"gone": {"root_mean_cm": 1.5}})");
   const Result inc = RunIrbench({"suite", "run", (dir / "inc.json").string(), "--cache", (dir / "cache").string(),
-                                 "--baselines", (fs::path(IRBENCH_SOURCE_DIR) / "ci" / "baselines").string()},
+                                 "--bless", "--baselines", (dir / "inc_baselines").string()},
                                 dir);
   EXPECT_EQ(inc.exit_code, 0) << inc.out << inc.err;
+  const auto inc_blessed = nlohmann::json::parse(ReadText(dir / "inc_baselines" / "inc.json"));
+  EXPECT_EQ(inc_blessed["gone"]["root_mean_cm"], 1.5) << inc_blessed.dump();
+  EXPECT_TRUE(inc_blessed.contains("p1_flap_lib")) << inc_blessed.dump();
   EXPECT_NE(inc.out.find("| p4_direct_traffic | root_mean_cm |"), std::string::npos) << inc.out;
+  EXPECT_NE(inc.out.find("| p1_flap_lib | root_mean_cm |"), std::string::npos) << inc.out;  // a name, not a file
   EXPECT_NE(inc.out.find("  gone  no motion file " + (dir / "no/such/clip.bvh").lexically_normal().string()),
             std::string::npos)
       << inc.out;

@@ -139,7 +139,8 @@ void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vect
     sc.render.avatar = s.GetString("avatar", "p1");
     sc.render.motion = ScenarioMotion(s.GetString("motion", "demo"), file);
     sc.optional = s.GetBool("optional", false);
-    if (sc.optional && !fs::is_regular_file(sc.render.motion)) {
+    const bool motion_is_file = sc.render.motion.find('/') != std::string::npos || fs::path(sc.render.motion).has_extension();
+    if (sc.optional && motion_is_file && !fs::is_regular_file(sc.render.motion)) {
       sc.missing = "no motion file " + sc.render.motion;
     }
     sc.render.sensor = s.GetString("sensor", "thesis");
@@ -155,7 +156,8 @@ void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vect
       if (sc.missing.empty()) {
         // The motion's own length, cut at max_seconds of the rig's frame rate.
         const RenderInputs in = LoadRenderInputs(sc.render);
-        sc.render.frames = std::min(in.frame_count, static_cast<int>(std::floor(max_s * in.fps + 1e-9)));
+        sc.render.frames =
+            std::max(1, std::min(in.frame_count, static_cast<int>(std::floor(max_s * in.fps + 1e-9))));
       }
     }
     sc.render.background_frames = s.GetInt("background_frames", 12);
@@ -540,6 +542,11 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   result.pooled = Pool(measured);
   WriteSummary(result, cache / ("suite-" + result.name));
   if (options.bless) {
+    // A skipped scenario keeps its blessed figures: blessing on a machine
+    // without the optional data must not drop them.
+    for (const auto& [scenario, why] : result.skipped) {
+      if (baseline.contains(scenario)) blessed[scenario] = baseline[scenario];
+    }
     fs::create_directories(baselines_dir);
     AtomicWriteFile(baseline_file, blessed.dump(2) + "\n");
     Log().info("suite {}: baseline written to {}", result.name, baseline_file.string());
