@@ -56,6 +56,9 @@ std::vector<Command> AddTrackCommand(CLI::App& app) {
   cmd->add_flag("--overlays", args->job.overlays, "also write debug overlays (PNG, colour)");
   cmd->add_flag("--ply", args->job.ply,
                 "also write the voxel and polyhedral hulls per frame as PLY");
+  cmd->add_flag("--descriptors", args->job.descriptors,
+                "also write every frame's shape descriptor (thesis 4.3) to descriptors.npy (float32, "
+                "frames x 13824 bins r-theta-phi; zeros where the stage looks empty)");
   cmd->add_option("--frames", args->frames, "frames to process (default: all)")
       ->transform(IntegerIn(1, 1000000));
   cmd->add_option("--out", args->out, "output folder (default: SEQ/track)");

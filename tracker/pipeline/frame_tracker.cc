@@ -164,6 +164,26 @@ nlohmann::json StageMs(const FrameFeatures& features, const std::optional<PoseEs
   return ms;
 }
 
+// The frame's shape descriptor: the hull's surface for the tracked user's
+// height, or the hull's top while the pose tracker has none.
+std::optional<ShapeDescriptor> Shape(const FrameFeatures& features, const std::optional<PoseEstimate>& pose,
+                                     const ShapeDescriptorOptions& options) {
+  if (!features.voxels || !features.placement) return std::nullopt;
+  const double height_m = pose && pose->tracking ? pose->shape.height_m : features.placement->top_m;
+  if (!(height_m > 0.3)) return std::nullopt;
+  return HullShapeDescriptor(*features.voxels, height_m, options);
+}
+
+// features.jsonl's summary of the descriptor (the whole one: irbench track
+// --descriptors).
+nlohmann::json ShapeJson(const std::optional<ShapeDescriptor>& shape) {
+  if (!shape) return nullptr;
+  return {{"points", shape->point_count},
+          {"nonempty_bins", shape->NonEmptyBins()},
+          {"height_m", std::round(shape->height_m * 1e3) / 1e3},
+          {"axis", {std::round(shape->axis_xy.x() * 1e4) / 1e4, std::round(shape->axis_xy.y() * 1e4) / 1e4}}};
+}
+
 }  // namespace
 
 std::shared_ptr<const RestClassifier> LoadRestClassifier(const TrackerSettings& settings) {
@@ -238,6 +258,10 @@ FrameTracker::Step FrameTracker::Track(int f,
     step.features.cameras[c].mean_level = status[c].mean_level;
   }
   if (pose_tracker_) step.pose = pose_tracker_->Step(step.features, dt);
+  const auto shape_start = std::chrono::steady_clock::now();
+  step.shape = Shape(step.features, step.pose, shape_options_);
+  const double shape_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shape_start).count();
   nlohmann::json& line = step.features_line;
   line["frame"] = f;
   line["t"] = f / input_.fps();
@@ -245,8 +269,10 @@ FrameTracker::Step FrameTracker::Track(int f,
     line["cameras"][input_.cameras()[c].name] = CameraFeaturesJson(step.features, c);
   }
   AddHullFeatures(step.features, input_.cameras(), line);
+  line["shape"] = ShapeJson(step.shape);
   step.track_line = TrackLine(f, f / input_.fps(), step.features, step.pose, input_.cameras(), line);
   line["ms"] = StageMs(step.features, step.pose);
+  line["ms"]["shape"] = shape_ms;
   step.track_line["ms"] = line["ms"];
   step.images = std::move(images);
   return step;

@@ -17,6 +17,7 @@
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/track_settings.h"
 #include "tracker/pose/pose_tracker.h"
+#include "tracker/shape/shape_descriptor.h"
 
 namespace irbench {
 
@@ -38,6 +39,10 @@ class FrameTracker {
     std::vector<cv::Mat> images;  // as read; black where a camera's frame is missing
     FrameFeatures features;
     std::optional<PoseEstimate> pose;
+    // The shape descriptor (thesis 4.3) of the voxel hull, for a user of the
+    // pose tracker's height (the hull's top before it has one); nullopt
+    // when the stage looks empty.
+    std::optional<ShapeDescriptor> shape;
     nlohmann::json features_line;  // features.jsonl's line, with "ms"
     nlohmann::json track_line;     // track.jsonl's line, with "ms"
   };
@@ -56,6 +61,7 @@ class FrameTracker {
   double train_ms_ = 0;
   FrontEnd front_end_;
   std::optional<PoseTracker> pose_tracker_;
+  ShapeDescriptorOptions shape_options_;
   CameraHealthMonitor health_;
   std::vector<CameraHealth> last_health_;  // per camera, to warn on changes
   std::vector<std::map<std::string, int>> left_out_counts_;

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/npy.h"
 #include "common/atomic_file.h"
 #include "common/cancel.h"
 #include "common/error.h"
@@ -116,6 +117,8 @@ struct TrackRun {
   FrameTracker& tracker;
   fs::path root;  // the staging folder
   std::string lines, track_lines;
+  std::optional<NpyRowWriter> descriptors;
+  int descriptor_bins = 0;
 };
 
 // Tracks frame f: the silhouettes (and overlays, PLY) written, a line
@@ -142,6 +145,9 @@ void TrackFrame(int f, TrackRun& run) {
     std::snprintf(stem, sizeof(stem), "%06d", f);
     if (features.voxels) WriteVoxelCubesPly(run.root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
     if (features.hull) WriteMeshPly(run.root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
+  }
+  if (run.descriptors) {
+    run.descriptors->Append(step.shape ? step.shape->bins : std::vector<float>(run.descriptor_bins, 0.0f));
   }
   run.lines += step.features_line.dump() + "\n";
   run.track_lines += step.track_line.dump() + "\n";
@@ -174,7 +180,8 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   Log().info("track: background models for {} cameras from {} empty-stage frames in {:.0f} ms",
              input.cameras().size(), input.background_count(), train_ms);
   const size_t nc = input.cameras().size();
-  TrackRun run{options, input, tracker, root, "", ""};
+  TrackRun run{options, input, tracker, root, "", "", std::nullopt, ShapeDescriptorOptions().bin_count()};
+  if (options.descriptors) run.descriptors.emplace(root / "descriptors.npy", frames, run.descriptor_bins);
   for (size_t c = 0; c < nc; ++c) {
     if (input.MissingFrames()[c] > 0) {
       Log().warn("track: camera {} lacks {} of {} frames; tracked without it there", input.cameras()[c].name,
@@ -190,6 +197,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
       progress.Set(f + 1, "frame");
     }
   }
+  if (run.descriptors) run.descriptors->Close();
   AtomicWriteFile(root / "features.jsonl", run.lines);
   AtomicWriteFile(root / "track.jsonl", run.track_lines);
   nlohmann::json meta = SettingsJson(settings);

@@ -20,6 +20,10 @@
 //   <out>/hull/NNNNNN_voxels.ply, NNNNNN_polyhedral.ply   (--ply) the voxel
 //                                  hull as cubes and the polyhedral hull, world
 //                                  metres, z up (MeshLab, Blender)
+//   <out>/descriptors.npy          (--descriptors) every frame's shape
+//                                  descriptor (thesis 4.3), float32, frames x
+//                                  bins (r, theta, phi in C order; docs/recognition.md);
+//                                  a row of zeros where the stage looks empty
 //
 // The output folder appears only when complete (StagingDir).
 
@@ -41,6 +45,7 @@ struct TrackJobOptions {
   TrackerSettings tracker;
   bool overlays = false;
   bool ply = false;
+  bool descriptors = false;
   std::optional<int> frames;  // default: all
   bool overwrite = false;
 };

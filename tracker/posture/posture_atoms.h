@@ -1,0 +1,75 @@
+#pragma once
+// The posture atoms (thesis 5.1): the dictionary a posture's shape descriptor
+// is decomposed over, learned from rendered training sequences (`irbench
+// train atoms`, ci/train/atom_training.h) and stored as a versioned model
+// file, irbench.posture-atoms/1 (JSON; docs/recognition.md):
+//
+//   A0, the resting posture: the mean unit-length descriptor of the training
+//       persons standing with both arms at rest. A user's own resting
+//       descriptor, once the tracker has seen them at rest, replaces it
+//       (UserRest, decompose.h): the torso and legs are most of the
+//       descriptor, and they differ more between persons than arms do.
+//   A1..A4, the arm atoms: the mean over one-arm training frames of the
+//       descriptor's part that is not the rest posture, f - <f, A0> A0
+//       (thesis Eq. 5.6), scaled so that one arm in the atom's posture
+//       weighs 1 (the thesis's alpha'_i, "the average weight" of a one-atom
+//       posture).
+//   The decision rule from weights to the [primary, secondary] pair, and its
+//   learned parameters.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tracker/shape/shape_descriptor.h"
+
+namespace irbench {
+
+// How the weights of the arm atoms are found (decompose.h).
+enum class AtomWeights {
+  kMatchingPursuit,  // the thesis's modified matching pursuit (5.1.1): atoms by bin overlap
+  kNonNegative,      // non-negative least squares over all arm atoms at once
+};
+// How the pair follows from the weights.
+enum class PairRule {
+  kThresholds,  // the thesis's: atoms above `presence`, two instances above `instance`
+  kCentroids,   // the nearest of the training pairs' mean weight vectors
+};
+
+const char* AtomWeightsName(AtomWeights w);
+const char* PairRuleName(PairRule r);
+
+struct PostureAtoms {
+  static constexpr const char* kFormat = "irbench.posture-atoms/1";
+
+  ShapeDescriptorOptions descriptor;  // what the atoms were computed with
+  std::vector<std::string> names;     // names[0] the rest posture ("A0"), then the arm atoms
+  std::vector<float> rest;            // A0, unit length
+  std::vector<std::vector<float>> arms;  // arms[k - 1]: atom k's arm part
+  AtomWeights weights = AtomWeights::kNonNegative;
+  int iterations = 3;               // matching pursuit's
+  double overlap_threshold = 1e-3;  // a bin takes part in an overlap above this
+  PairRule rule = PairRule::kCentroids;
+  double presence = 0.4;  // thresholds rule: an atom is present at this weight
+  double instance = 1.3;  // ... and twice present at this one
+  // Centroids rule: per pair ("A1+A3", names in order), its mean arm-atom
+  // weights over the training frames.
+  std::vector<std::pair<std::string, std::vector<double>>> centroids;
+  nlohmann::json provenance;  // how the file was made
+
+  int atom_count() const { return static_cast<int>(names.size()); }
+  // Throws InputError naming `file` and the field when the parts disagree.
+  void Check(const std::string& file = "") const;
+
+  // Throws InputError naming the file and field on anything malformed, of
+  // another format, or whose vectors do not have the descriptor's bin count.
+  static PostureAtoms Load(const std::filesystem::path& path);
+  void Save(const std::filesystem::path& path) const;  // atomic
+};
+
+// Where the tracker finds the atoms by default: tracker/models/posture_atoms.json
+// under the data root.
+std::filesystem::path DefaultPostureAtomsPath();
+
+}  // namespace irbench
