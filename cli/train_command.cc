@@ -1,9 +1,11 @@
 // `irbench train rest`: train the tracker's rest-state SVM from simulated truth.
+// `irbench train atoms`: learn the posture atoms from rendered sequences.
 
 #include <iostream>
 #include <memory>
 #include <string>
 
+#include "ci/train/atom_training.h"
 #include "ci/train/rest_training.h"
 #include "cli/commands.h"
 #include "cli/option_checks.h"
@@ -26,6 +28,29 @@ int RunTrainRest(const CLI::App& cmd, TrainRestArgs& args) {
   std::cout << "rest-state SVM: " << r.samples << " arm samples (" << r.at_rest << " at rest), "
             << train_rest.folds << "-fold cross-validated accuracy " << r.cv_accuracy * 100 << "%\n"
             << r.model.string() << "\n";
+  return kExitOk;
+}
+
+// What `irbench train atoms`' flags bind to.
+struct TrainAtomsArgs {
+  AtomTrainingOptions job;
+  std::vector<std::string> sequences;
+  std::string out, weights = "non_negative", rule = "centroids";
+};
+
+// Learns the atoms; prints the training and held-out accuracies and the model file.
+int RunTrainAtoms(const CLI::App& cmd, TrainAtomsArgs& args) {
+  RequireNotEmpty(cmd, "--out", args.out);
+  AtomTrainingOptions& job = args.job;
+  for (const std::string& s : args.sequences) job.sequences.emplace_back(s);
+  job.out = args.out;
+  job.weights = args.weights == "matching_pursuit" ? AtomWeights::kMatchingPursuit : AtomWeights::kNonNegative;
+  job.rule = args.rule == "thresholds" ? PairRule::kThresholds : PairRule::kCentroids;
+  const AtomTrainingResult r = RunAtomTraining(job);
+  std::cout << "posture atoms: " << r.frames << " frames, pairs right on " << r.training_accuracy * 100
+            << "% of the training frames\n";
+  for (const auto& [name, acc] : r.held_out) std::cout << "  " << name << " held out: " << acc * 100 << "%\n";
+  std::cout << r.model.string() << "\n";
   return kExitOk;
 }
 
@@ -54,7 +79,26 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
       ->capture_default_str()
       ->transform(Uint64Text());
   cmd->add_option("--out", args->out, "model file (default: tracker/models/rest_svm.yml)");
-  return {{cmd, [cmd, args] { return RunTrainRest(*cmd, *args); }}};
+  auto atom_args = std::make_shared<TrainAtomsArgs>();
+  CLI::App* atoms_cmd = train_cmd->add_subcommand(
+      "atoms",
+      "Posture atoms (thesis 5.1): the resting posture and four arm atoms of the shape descriptor,\n"
+      "and the rule from atom weights to the recognised pair, from rendered sequences of the atom\n"
+      "tour (irbench render --motion atom_tour) on training persons, tracked by the front end");
+  atoms_cmd->add_option("SEQ", atom_args->sequences, "rendered sequences with truth, one person each")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  atoms_cmd->add_option("--weights", atom_args->weights, "how atom weights are found")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"non_negative", "matching_pursuit"}));
+  atoms_cmd->add_option("--rule", atom_args->rule, "how the pair follows from the weights")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"centroids", "thresholds"}));
+  atoms_cmd->add_flag("!--no-cross-validation", atom_args->job.cross_validate,
+                      "skip the leave-one-sequence-out accuracies");
+  atoms_cmd->add_option("--out", atom_args->out, "model file (default: tracker/models/posture_atoms.json)");
+  return {{cmd, [cmd, args] { return RunTrainRest(*cmd, *args); }},
+          {atoms_cmd, [atoms_cmd, atom_args] { return RunTrainAtoms(*atoms_cmd, *atom_args); }}};
 }
 
 }  // namespace irbench::cli

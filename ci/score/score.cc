@@ -55,6 +55,9 @@ std::string TrackState(const Json& line, const fs::path& file) {
   return s;
 }
 
+// "A1+A3": an unordered pair of atom names, in order.
+std::string PairKey(const std::string& a, const std::string& b) { return a < b ? a + "+" + b : b + "+" + a; }
+
 const Json* Child(const Json& j, const std::string& key) {
   return j.is_object() && j.contains(key) && !j[key].is_null() ? &j[key] : nullptr;
 }
@@ -219,6 +222,22 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       ++score.motion.total;
       score.motion.correct += label == truth_label;
     }
+    // Postures: unordered atom pairs, whenever the hull gave the tracker one.
+    const Json* truth_posture = truth_labels ? Child(*truth_labels, "posture") : nullptr;
+    if (truth_posture && truth_posture->is_array() && truth_posture->size() == 2 && (*truth_posture)[0].is_string() &&
+        (*truth_posture)[1].is_string()) {
+      const std::string truth_pair = PairKey((*truth_posture)[0], (*truth_posture)[1]);
+      const Json* track_posture = Child(*track, "posture");
+      const Json* pair = track_posture && track_posture->is_object() ? Child(*track_posture, "pair") : nullptr;
+      if (pair && pair->is_array() && pair->size() == 2 && (*pair)[0].is_string() && (*pair)[1].is_string()) {
+        const std::string tracked_pair = PairKey((*pair)[0], (*pair)[1]);
+        ++score.posture_confusion[truth_pair][tracked_pair];
+        ++score.posture.total;
+        score.posture.correct += tracked_pair == truth_pair;
+      } else {
+        ++score.posture.missing;
+      }
+    }
   }
   // One Chauvenet pass per series gives both the summary and the per-frame flags.
   auto summarise = [](const std::vector<double>& errors, const std::vector<int>& frames, int missing,
@@ -237,6 +256,39 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
   }
   return score;
 }
+
+namespace {
+
+// A confusion matrix (truth -> found -> count) as a Markdown table, rows
+// truth, columns found, over the labels either side uses.
+std::string ConfusionMarkdown(const std::map<std::string, std::map<std::string, int>>& confusion) {
+  std::vector<std::string> labels;
+  for (const auto& [t, row] : confusion) {
+    labels.push_back(t);
+    for (const auto& [l, n] : row) labels.push_back(l);
+  }
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  std::ostringstream out;
+  out << "| |";
+  for (const std::string& l : labels) out << " " << l << " |";
+  out << "\n|---|";
+  for (size_t i = 0; i < labels.size(); ++i) out << "---|";
+  out << "\n";
+  for (const std::string& t : labels) {
+    const auto row = confusion.find(t);
+    if (row == confusion.end()) continue;
+    out << "| " << t << " |";
+    for (const std::string& l : labels) {
+      const auto c = row->second.find(l);
+      out << " " << (c == row->second.end() ? 0 : c->second) << " |";
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
 
 nlohmann::json Score::ToJson() const {
   auto stats = [](const ErrorStats& s) {
@@ -261,6 +313,10 @@ nlohmann::json Score::ToJson() const {
                         {"total", motion.total},
                         {"missing", motion.missing},
                         {"confusion", motion_confusion}};
+  j["postures"] = {{"accuracy", posture.total ? Json(posture.rate()) : Json(nullptr)},
+                   {"total", posture.total},
+                   {"missing", posture.missing},
+                   {"confusion", posture_confusion}};
   j["silhouettes"] = silhouettes ? silhouettes->ToJson() : Json(nullptr);
   return j;
 }
@@ -293,29 +349,15 @@ std::string Score::Markdown() const {
         << " | " << a.missing << " |\n";
   }
   if (!motion_confusion.empty()) {
-    std::vector<std::string> labels;
-    for (const auto& [t, row] : motion_confusion) {
-      labels.push_back(t);
-      for (const auto& [l, n] : row) labels.push_back(l);
-    }
-    std::sort(labels.begin(), labels.end());
-    labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
     out << "\n**Motion labels** (thesis Tables 7.1-7.2; rows truth, columns tracked; accuracy "
-        << Fixed(100 * motion.rate(), 2) << "%)\n\n| |";
-    for (const std::string& l : labels) out << " " << l << " |";
-    out << "\n|---|";
-    for (size_t i = 0; i < labels.size(); ++i) out << "---|";
-    out << "\n";
-    for (const std::string& t : labels) {
-      const auto row = motion_confusion.find(t);
-      if (row == motion_confusion.end()) continue;
-      out << "| " << t << " |";
-      for (const std::string& l : labels) {
-        const auto c = row->second.find(l);
-        out << " " << (c == row->second.end() ? 0 : c->second) << " |";
-      }
-      out << "\n";
-    }
+        << Fixed(100 * motion.rate(), 2) << "%)\n\n"
+        << ConfusionMarkdown(motion_confusion);
+  }
+  if (!posture_confusion.empty()) {
+    out << "\n**Postures** (thesis 5.1: atom pairs, unordered; rows truth, columns recognised; "
+        << Fixed(100 * posture.rate(), 2) << "% of " << posture.total << " frames right, " << posture.missing
+        << " without a posture)\n\n"
+        << ConfusionMarkdown(posture_confusion);
   }
   if (silhouettes) out << "\n" << silhouettes->Markdown();
   return out.str();

@@ -72,6 +72,11 @@ struct Score {
   // Motion labels: truth label -> tracked label -> count, both arms together.
   std::map<std::string, std::map<std::string, int>> motion_confusion;
   Accuracy motion;
+  // Postures (thesis 5.1): the truth's [primary, secondary] atoms against the
+  // tracker's recognised pair, as unordered pairs ("A1+A3", names in
+  // order); truth pair -> recognised pair -> count.
+  std::map<std::string, std::map<std::string, int>> posture_confusion;
+  Accuracy posture;
   // The tracker's silhouettes against the truth masks, when the track folder
   // has them (irbench track writes silhouettes/ beside track.jsonl).
   std::optional<SilhouetteScore> silhouettes;

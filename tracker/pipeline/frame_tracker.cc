@@ -184,6 +184,17 @@ nlohmann::json ShapeJson(const std::optional<ShapeDescriptor>& shape) {
           {"axis", {std::round(shape->axis_xy.x() * 1e4) / 1e4, std::round(shape->axis_xy.y() * 1e4) / 1e4}}};
 }
 
+// track.jsonl's posture: the recognised pair (atom names in lexical order)
+// and every atom's weight; null without atoms or a descriptor.
+nlohmann::json PostureJson(const std::optional<Posture>& posture, const PostureAtoms* atoms) {
+  if (!posture || !atoms) return nullptr;
+  nlohmann::json weights = nlohmann::json::object();
+  for (size_t k = 0; k < posture->weights.size(); ++k) {
+    weights[atoms->names[k]] = std::round(posture->weights[k] * 1e4) / 1e4;
+  }
+  return {{"pair", {atoms->names[posture->pair[0]], atoms->names[posture->pair[1]]}}, {"weights", weights}};
+}
+
 }  // namespace
 
 std::shared_ptr<const RestClassifier> LoadRestClassifier(const TrackerSettings& settings) {
@@ -220,6 +231,12 @@ FrameTracker::FrameTracker(const SequenceInput& input,
   if (settings.stage == TrackStage::kPose) {
     pose_tracker_.emplace(input.cameras(), input.screens(), settings.pose);
     if (rest_classifier) pose_tracker_->set_rest_classifier(std::move(rest_classifier));
+  }
+  const fs::path atoms = settings.posture_atoms.empty() ? DefaultPostureAtomsPath() : settings.posture_atoms;
+  if (!settings.posture_atoms.empty() || fs::exists(atoms)) {
+    posture_atoms_ = std::make_shared<PostureAtoms>(PostureAtoms::Load(atoms));
+    posture_atoms_path_ = atoms;
+    shape_options_ = posture_atoms_->descriptor;
   }
 }
 
@@ -260,6 +277,12 @@ FrameTracker::Step FrameTracker::Track(int f,
   if (pose_tracker_) step.pose = pose_tracker_->Step(step.features, dt);
   const auto shape_start = std::chrono::steady_clock::now();
   step.shape = Shape(step.features, step.pose, shape_options_);
+  if (step.shape && posture_atoms_) {
+    const bool at_rest = step.pose && step.pose->tracking && step.pose->rest[0].value_or(false) &&
+                         step.pose->rest[1].value_or(false);
+    user_rest_.Update(step.shape->bins, at_rest);
+    step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_);
+  }
   const double shape_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shape_start).count();
   nlohmann::json& line = step.features_line;
@@ -273,6 +296,7 @@ FrameTracker::Step FrameTracker::Track(int f,
   step.track_line = TrackLine(f, f / input_.fps(), step.features, step.pose, input_.cameras(), line);
   line["ms"] = StageMs(step.features, step.pose);
   line["ms"]["shape"] = shape_ms;
+  step.track_line["posture"] = PostureJson(step.posture, posture_atoms_.get());
   step.track_line["ms"] = line["ms"];
   step.images = std::move(images);
   return step;

@@ -17,6 +17,7 @@
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/track_settings.h"
 #include "tracker/pose/pose_tracker.h"
+#include "tracker/posture/decompose.h"
 #include "tracker/shape/shape_descriptor.h"
 
 namespace irbench {
@@ -43,6 +44,9 @@ class FrameTracker {
     // pose tracker's height (the hull's top before it has one); nullopt
     // when the stage looks empty.
     std::optional<ShapeDescriptor> shape;
+    // Its decomposition into the posture atoms (thesis 5.1.1), when the
+    // tracker has atoms and a descriptor.
+    std::optional<Posture> posture;
     nlohmann::json features_line;  // features.jsonl's line, with "ms"
     nlohmann::json track_line;     // track.jsonl's line, with "ms"
   };
@@ -52,6 +56,8 @@ class FrameTracker {
   Step Track(int f, std::vector<cv::Mat> images, const std::vector<std::string>& problems, double dt);
 
   double train_ms() const { return train_ms_; }
+  // The posture atoms' file in use; empty when posture recognition is off.
+  const std::filesystem::path& posture_atoms_path() const { return posture_atoms_path_; }
   const FrontEnd& front_end() const { return front_end_; }
   // Per camera, how many frame-sets it was left out of, by reason.
   const std::vector<std::map<std::string, int>>& left_out_counts() const { return left_out_counts_; }
@@ -61,7 +67,10 @@ class FrameTracker {
   double train_ms_ = 0;
   FrontEnd front_end_;
   std::optional<PoseTracker> pose_tracker_;
-  ShapeDescriptorOptions shape_options_;
+  ShapeDescriptorOptions shape_options_;  // the atoms' when there are atoms
+  std::filesystem::path posture_atoms_path_;
+  std::shared_ptr<const PostureAtoms> posture_atoms_;
+  UserRest user_rest_;
   CameraHealthMonitor health_;
   std::vector<CameraHealth> last_health_;  // per camera, to warn on changes
   std::vector<std::map<std::string, int>> left_out_counts_;

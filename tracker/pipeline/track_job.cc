@@ -107,6 +107,7 @@ void CheckOutputOutsideSequence(const TrackJobOptions& options) {
     inputs.push_back(options.sequence / part);
   }
   inputs.push_back(options.tracker.rest_model.empty() ? DefaultRestModelPath() : options.tracker.rest_model);
+  inputs.push_back(options.tracker.posture_atoms.empty() ? DefaultPostureAtomsPath() : options.tracker.posture_atoms);
   CheckOutputApart(out, inputs, "--out");
 }
 
@@ -234,6 +235,10 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     const fs::path rest_path = settings.rest_model.empty() ? DefaultRestModelPath() : settings.rest_model;
     models["rest_state"] = {{"file", fs::absolute(rest_path).lexically_normal().string()},
                             {"sha256", Sha256OfFile(rest_path)}};
+  }
+  if (!tracker.posture_atoms_path().empty()) {
+    models["posture_atoms"] = {{"file", fs::absolute(tracker.posture_atoms_path()).lexically_normal().string()},
+                               {"sha256", Sha256OfFile(tracker.posture_atoms_path())}};
   }
   meta["models"] = models;
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");

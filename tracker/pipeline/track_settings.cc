@@ -63,6 +63,11 @@ std::vector<TrackSetting> MakeSettings() {
       {"rest_model", "--rest-model",
        "pose: rest-state SVM (default: tracker/models/rest_svm.yml when present)",
        PathBinding{[](TrackerSettings& t) -> std::filesystem::path& { return t.rest_model; }}});
+  s.push_back(
+      {"posture_atoms", "--posture-atoms",
+       "posture atoms of the shape descriptor's decomposition (default: tracker/models/posture_atoms.json "
+       "when present)",
+       PathBinding{[](TrackerSettings& t) -> std::filesystem::path& { return t.posture_atoms; }}});
   s.push_back({"background_model", "--background-model",
                "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)",
                ChoiceBinding{{"flicker", "plain"},

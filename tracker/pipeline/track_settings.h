@@ -36,6 +36,9 @@ struct TrackerSettings {
   // pose: the rest-state SVM (irbench train rest); empty: the default model
   // (tracker/models/rest_svm.yml) when it exists, else rest stays null.
   std::filesystem::path rest_model;
+  // The posture atoms (irbench train atoms); empty: the default model
+  // (tracker/models/posture_atoms.json) when it exists, else posture stays null.
+  std::filesystem::path posture_atoms;
 };
 
 // The binding kinds. `ref` gives the setting's field in a TrackerSettings.

@@ -88,7 +88,8 @@ PostureAtoms PostureAtoms::Load(const std::filesystem::path& path) {
   }
   PostureAtoms a;
   const JsonNode d = root["descriptor"];
-  d.CheckKeys({"rings", "azimuths", "r_bins", "theta_bins", "phi_bins", "radius_per_height", "max_points"});
+  d.CheckKeys({"rings", "azimuths", "r_bins", "theta_bins", "phi_bins", "radius_per_height", "max_points",
+               "smoothing_bins"});
   a.descriptor.rings = d.GetInt("rings");
   a.descriptor.azimuths = d.GetInt("azimuths");
   a.descriptor.r_bins = d.GetInt("r_bins");
@@ -96,6 +97,7 @@ PostureAtoms PostureAtoms::Load(const std::filesystem::path& path) {
   a.descriptor.phi_bins = d.GetInt("phi_bins");
   a.descriptor.radius_per_height = d.GetDouble("radius_per_height");
   a.descriptor.max_points = d.GetInt("max_points");
+  a.descriptor.smoothing_bins = d.GetDouble("smoothing_bins");
   try {
     a.descriptor.Check();
   } catch (const InputError& e) {
@@ -143,7 +145,8 @@ void PostureAtoms::Save(const std::filesystem::path& path) const {
                      {"theta_bins", descriptor.theta_bins},
                      {"phi_bins", descriptor.phi_bins},
                      {"radius_per_height", descriptor.radius_per_height},
-                     {"max_points", descriptor.max_points}};
+                     {"max_points", descriptor.max_points},
+                     {"smoothing_bins", descriptor.smoothing_bins}};
   j["names"] = names;
   j["weights"] = AtomWeightsName(weights);
   j["iterations"] = iterations;
@@ -151,7 +154,6 @@ void PostureAtoms::Save(const std::filesystem::path& path) const {
   j["rule"] = PairRuleName(rule);
   j["presence"] = presence;
   j["instance"] = instance;
-  nlohmann::ordered_json unused;
   nlohmann::json c = nlohmann::json::object();
   for (const auto& [pair, w] : centroids) {
     nlohmann::json row = nlohmann::json::array();
@@ -162,7 +164,12 @@ void PostureAtoms::Save(const std::filesystem::path& path) const {
   j["rest"] = SparseJson(rest);
   j["arms"] = nlohmann::json::array();
   for (const auto& arm : arms) j["arms"].push_back(SparseJson(arm));
-  AtomicWriteFile(path, j.dump(1) + "\n");
+  // One key a line, each value compact: a header a reader can scan.
+  std::string text = "{\n";
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    text += (it == j.begin() ? " " : ",\n ") + nlohmann::json(it.key()).dump() + ": " + it.value().dump();
+  }
+  AtomicWriteFile(path, text + "\n}\n");
 }
 
 std::filesystem::path DefaultPostureAtomsPath() { return DataRoot() / "tracker" / "models" / "posture_atoms.json"; }

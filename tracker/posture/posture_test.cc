@@ -208,7 +208,7 @@ TEST(Posture, ModelFileRoundTripAndErrors) {
   };
   expect_error(replaced("irbench.posture-atoms/1", "irbench.posture-atoms/9"), "format");
   // A model made for another descriptor size.
-  expect_error(replaced("\"phi_bins\": 8", "\"phi_bins\": 24"), "rest.bins");
+  expect_error(replaced("\"phi_bins\":8", "\"phi_bins\":24"), "rest.bins");
   expect_error(replaced("\"rule\": \"centroids\"", "\"rule\": \"nearest\""), "rule");
   expect_error(replaced("\"iterations\": 3", "\"iterations\": 0"), "iterations");
   std::filesystem::remove_all(dir);

@@ -1,6 +1,7 @@
 #include "tracker/shape/shape_descriptor.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -8,6 +9,43 @@
 #include "common/error.h"
 
 namespace irbench {
+namespace {
+
+// Blurs `h` (dims[0] x dims[1] x dims[2], C order) along `axis` with
+// `kernel` (odd length, centred); `circular`: the axis wraps, else what
+// falls beyond the edges is dropped.
+void BlurAxis(std::vector<double>& h, const std::array<int, 3>& dims, int axis, const std::vector<double>& kernel,
+              bool circular) {
+  const int n = dims[axis], half = static_cast<int>(kernel.size()) / 2;
+  const int stride = axis == 2 ? 1 : axis == 1 ? dims[2] : dims[1] * dims[2];
+  std::vector<double> line(n), out(n);
+  for (int a = 0; a < dims[0]; ++a) {
+    for (int b = 0; b < dims[1]; ++b) {
+      for (int c = 0; c < dims[2]; ++c) {
+        const int coord = axis == 0 ? a : axis == 1 ? b : c;
+        if (coord != 0) continue;  // one line per start
+        const size_t base = (static_cast<size_t>(a) * dims[1] + b) * dims[2] + c;
+        for (int i = 0; i < n; ++i) line[i] = h[base + static_cast<size_t>(i) * stride];
+        for (int i = 0; i < n; ++i) {
+          double v = 0;
+          for (int o = -half; o <= half; ++o) {
+            int j = i + o;
+            if (circular) {
+              j = ((j % n) + n) % n;
+            } else if (j < 0 || j >= n) {
+              continue;
+            }
+            v += kernel[o + half] * line[j];
+          }
+          out[i] = v;
+        }
+        for (int i = 0; i < n; ++i) h[base + static_cast<size_t>(i) * stride] = out[i];
+      }
+    }
+  }
+}
+
+}  // namespace
 
 void ShapeDescriptorOptions::Check() const {
   auto positive = [](int v, int hi, const char* field) {
@@ -19,6 +57,7 @@ void ShapeDescriptorOptions::Check() const {
   positive(theta_bins, 256, "theta_bins");
   positive(phi_bins, 256, "phi_bins");
   positive(max_points, 1 << 24, "max_points");
+  if (!(smoothing_bins >= 0 && smoothing_bins <= 4)) throw InputError("", "smoothing_bins", "must be in 0..4");
   if (!(radius_per_height > 0 && radius_per_height <= 2)) {
     throw InputError("", "radius_per_height", "must be in (0, 2]");
   }
@@ -108,9 +147,24 @@ ShapeDescriptor ComputeShapeDescriptor(const std::vector<Eigen::Vector3d>& point
       }
     }
   }
-  const uint32_t largest = *std::max_element(counts.begin(), counts.end());
-  out.bins.resize(counts.size());
-  for (size_t i = 0; i < counts.size(); ++i) out.bins[i] = static_cast<float>(counts[i]) / largest;
+  std::vector<double> h(counts.begin(), counts.end());
+  if (options.smoothing_bins > 0) {
+    std::vector<double> kernel;
+    for (int o = -3; o <= 3; ++o) kernel.push_back(std::exp(-0.5 * o * o / (options.smoothing_bins * options.smoothing_bins)));
+    double sum = 0;
+    for (double k : kernel) sum += k;
+    for (double& k : kernel) k /= sum;
+    const std::array<int, 3> dims = {kr, kt, kp};
+    BlurAxis(h, dims, 0, kernel, false);
+    BlurAxis(h, dims, 1, kernel, false);
+    BlurAxis(h, dims, 2, kernel, true);
+  }
+  const double largest = *std::max_element(h.begin(), h.end());
+  out.bins.resize(h.size());
+  for (size_t i = 0; i < h.size(); ++i) {
+    // Below 1e-6 of the largest bin is empty (the blur's far tails).
+    out.bins[i] = h[i] > 1e-6 * largest ? static_cast<float>(h[i] / largest) : 0.0f;
+  }
   return out;
 }
 

@@ -21,6 +21,13 @@
 //   r = |d| / diag, diag = sqrt((2R)^2 + h^2) the cylinder's largest chord,
 //   clamped to [0, 1]; theta = the angle from z, [0, pi]; phi = atan2(d.t,
 //   d.n), [-pi, pi). Each into equal bins.
+// - Smoothing: the summed histogram is blurred by a Gaussian of
+//   `smoothing_bins` bins (standard deviation) along each of r, theta (the
+//   edges absorb what falls off) and phi (circular), kernel cut at 3 bins,
+//   before the normalisation. 24 bins a side resolve postures, but a
+//   broader or taller person shifts an arm's mass by a bin, and an
+//   unsmoothed histogram then shares little with the atoms learned on
+//   others (measured: docs/recognition.md).
 // - Facing: summing over the azimuths makes the descriptor invariant to turns
 //   about the vertical axis by multiples of 360/azimuths degrees (and nearly
 //   so between), so no facing is needed. The thesis notes the consequence: a
@@ -41,6 +48,7 @@ struct ShapeDescriptorOptions {
   int phi_bins = 24;
   double radius_per_height = 0.5;  // cylinder radius / user height
   int max_points = 1500;           // surface points used, at most
+  double smoothing_bins = 1.0;     // Gaussian blur of the histogram, bins; 0: none
 
   int bin_count() const { return r_bins * theta_bins * phi_bins; }
   void Check() const;  // throws InputError naming the field

@@ -72,7 +72,8 @@ TEST(ShapeDescriptor, SurfaceVoxelsOfACylinder) {
 //           theta = 129.81 deg -> bin 17
 // phi = +-180 deg -> bin 12 (bins centred on multiples of 15 deg).
 TEST(ShapeDescriptor, OnePointOnTheAxisMatchesHandComputedBins) {
-  const ShapeDescriptorOptions o;
+  ShapeDescriptorOptions o;
+  o.smoothing_bins = 0;
   const ShapeDescriptor d = ComputeShapeDescriptor({Eigen::Vector3d(0.3, -0.2, 0.75)}, 1.8, o);
   ASSERT_EQ(d.bins.size(), size_t(24 * 24 * 24));
   EXPECT_EQ(d.point_count, 1);
@@ -83,11 +84,32 @@ TEST(ShapeDescriptor, OnePointOnTheAxisMatchesHandComputedBins) {
   EXPECT_NEAR(d.axis_xy.x(), 0.3, 1e-6);
 }
 
+// Smoothed, each peak spreads as the product of one Gaussian per axis: a
+// neighbour one bin away along one axis holds exp(-1/2) of the peak, two
+// axes away exp(-1); phi's neighbours on both sides alike.
+TEST(ShapeDescriptor, SmoothingIsAGaussianPerAxis) {
+  ShapeDescriptorOptions o;
+  o.smoothing_bins = 1.0;
+  const ShapeDescriptor d = ComputeShapeDescriptor({Eigen::Vector3d(0.3, -0.2, 0.75)}, 1.8, o);
+  const float peak = d.bins[BinIndex(o, 9, 8, 12)];
+  EXPECT_FLOAT_EQ(peak, 1.0f);
+  EXPECT_NEAR(d.bins[BinIndex(o, 10, 8, 12)], std::exp(-0.5), 1e-5);
+  EXPECT_NEAR(d.bins[BinIndex(o, 9, 7, 12)], std::exp(-0.5), 1e-5);
+  EXPECT_NEAR(d.bins[BinIndex(o, 9, 8, 11)], std::exp(-0.5), 1e-5);
+  EXPECT_NEAR(d.bins[BinIndex(o, 9, 8, 13)], std::exp(-0.5), 1e-5);
+  EXPECT_NEAR(d.bins[BinIndex(o, 10, 9, 12)], std::exp(-1.0), 1e-5);
+  EXPECT_NEAR(d.bins[BinIndex(o, 9, 8, 15)], std::exp(-4.5), 1e-5);
+  EXPECT_EQ(d.bins[BinIndex(o, 9, 8, 16)], 0.0f);  // beyond the kernel's 3 bins
+  // A peak at phi bin 12 reaches bins 9..15 only.
+  EXPECT_EQ(d.bins[BinIndex(o, 9, 8, 0)], 0.0f);
+}
+
 // Off the axis the histogram is the sum over the reference points; two
 // points on opposite sides give the same counts as one point does, twice:
 // each counts 48 times, the largest bin is normalised to 1.
 TEST(ShapeDescriptor, BinsSumToTheReferencePointsTimesThePoints) {
   ShapeDescriptorOptions o;
+  o.smoothing_bins = 0;
   o.r_bins = o.theta_bins = o.phi_bins = 8;
   const std::vector<Eigen::Vector3d> points = {{0.2, 0, 1.0}, {-0.2, 0, 1.0}, {0, 0.1, 0.4}};
   const ShapeDescriptor d = ComputeShapeDescriptor(points, 1.7, o);

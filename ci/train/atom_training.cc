@@ -1,0 +1,277 @@
+#include "ci/train/atom_training.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "common/error.h"
+#include "common/logging.h"
+#include "common/paths.h"
+#include "common/progress.h"
+#include "sequence_format/frame_lines.h"
+#include "sequence_format/manifest.h"
+#include "tracker/io/sequence_input.h"
+#include "tracker/pipeline/frame_tracker.h"
+#include "tracker/posture/decompose.h"
+
+namespace irbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string>& AtomNames() {
+  static const std::vector<std::string> names = {"A0", "A1", "A2", "A3", "A4"};
+  return names;
+}
+
+// A unit-length descriptor by its non-zero bins.
+struct SparseDescriptor {
+  std::vector<int> index;
+  std::vector<float> value;
+  std::vector<float> Dense(int bins) const {
+    std::vector<float> d(bins, 0.0f);
+    for (size_t i = 0; i < index.size(); ++i) d[index[i]] = value[i];
+    return d;
+  }
+};
+
+// One training sequence (one person) as the tracker saw it.
+struct TrainingSequence {
+  std::string name;
+  nlohmann::json about;  // for the provenance
+  std::vector<SparseDescriptor> frames;
+  std::vector<std::array<int, 2>> pairs;  // the truth's, atom indices in order
+  std::vector<float> own_rest;            // the person's resting posture, unit length
+};
+
+int AtomIndex(const std::string& name, const fs::path& file, int frame) {
+  const auto& names = AtomNames();
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) {
+    throw InputError(file.string(), "frame " + std::to_string(frame) + ".labels.posture",
+                     "unknown atom '" + name + "'");
+  }
+  return static_cast<int>(it - names.begin());
+}
+
+// Runs the tracker over `dir` and pairs its descriptors with the truth.
+TrainingSequence ReadSequence(const fs::path& dir, const ShapeDescriptorOptions& shape) {
+  TrainingSequence s;
+  s.name = dir.filename().string();
+  const Manifest manifest = ReadManifest(dir);
+  s.about = {{"name", s.name}, {"avatar", manifest.avatar}, {"motion", manifest.motion},
+             {"sensor", manifest.sensor}, {"rig", manifest.rig}, {"seed", manifest.seed}};
+  const fs::path truth_file = dir / "truth" / "frames.jsonl";
+  const std::map<int, nlohmann::json> truth = ReadFrameLines(truth_file);
+  const SequenceInput input = SequenceInput::Open(dir);
+  TrackerSettings settings;
+  FrameTracker tracker(input, settings, EffectiveFrontEndOptions(settings), LoadRestClassifier(settings));
+  const int bins = shape.bin_count();
+  std::vector<double> rest_sum(bins, 0.0);
+  int rest_frames = 0;
+  Progress progress("train atoms: " + s.name, "frame-sets", input.frame_count());
+  for (int f = 0; f < input.frame_count(); ++f) {
+    std::vector<std::string> problems;
+    const FrameTracker::Step step = tracker.Track(f, input.TryFrameSet(f, &problems), problems, 1.0 / input.fps());
+    progress.Set(f + 1, "frame");
+    const auto t = truth.find(f);
+    if (!step.shape || step.shape->point_count == 0 || t == truth.end()) continue;
+    const nlohmann::json& posture = t->second["labels"]["posture"];
+    if (!posture.is_array() || posture.size() != 2) {
+      throw InputError(truth_file.string(), "frame " + std::to_string(f) + ".labels.posture", "must be two atoms");
+    }
+    const int a = AtomIndex(posture[0].get<std::string>(), truth_file, f);
+    const int b = AtomIndex(posture[1].get<std::string>(), truth_file, f);
+    double norm = 0;
+    for (float v : step.shape->bins) norm += double(v) * v;
+    norm = std::sqrt(norm);
+    SparseDescriptor d;
+    for (int i = 0; i < bins; ++i) {
+      if (step.shape->bins[i] == 0) continue;
+      d.index.push_back(i);
+      d.value.push_back(static_cast<float>(step.shape->bins[i] / norm));
+    }
+    if (a == 0 && b == 0) {
+      for (size_t i = 0; i < d.index.size(); ++i) rest_sum[d.index[i]] += d.value[i];
+      ++rest_frames;
+    }
+    s.frames.push_back(std::move(d));
+    s.pairs.push_back({std::min(a, b), std::max(a, b)});
+  }
+  if (rest_frames == 0) throw InputError(dir.string(), "truth", "the person is never at rest with both arms");
+  double norm = 0;
+  for (double v : rest_sum) norm += v * v;
+  s.own_rest.resize(bins);
+  for (int i = 0; i < bins; ++i) s.own_rest[i] = static_cast<float>(rest_sum[i] / std::sqrt(norm));
+  return s;
+}
+
+std::vector<double> ArmWeights(const PostureAtoms& atoms, const std::vector<float>& residual) {
+  return atoms.weights == AtomWeights::kMatchingPursuit
+             ? MatchingPursuitWeights(residual, atoms.arms, atoms.iterations, atoms.overlap_threshold)
+             : NonNegativeWeights(residual, atoms.arms);
+}
+
+// Every frame's arm weights under `atoms`, the person's own rest subtracted.
+std::vector<std::vector<double>> Weights(const PostureAtoms& atoms, const TrainingSequence& s) {
+  std::vector<std::vector<double>> w;
+  for (const SparseDescriptor& d : s.frames) {
+    double alpha0 = 0;
+    w.push_back(ArmWeights(atoms, RestResidual(d.Dense(atoms.descriptor.bin_count()), s.own_rest, &alpha0)));
+  }
+  return w;
+}
+
+double Accuracy(const PostureAtoms& atoms, const std::vector<const TrainingSequence*>& seqs,
+                const std::vector<std::vector<std::vector<double>>>& weights) {
+  long right = 0, total = 0;
+  for (size_t q = 0; q < seqs.size(); ++q) {
+    for (size_t f = 0; f < seqs[q]->frames.size(); ++f) {
+      right += PairFromWeights(weights[q][f], atoms) == seqs[q]->pairs[f];
+      ++total;
+    }
+  }
+  return total ? double(right) / total : 0.0;
+}
+
+// Steps 2-3 from the sequences `train`.
+PostureAtoms Fit(const std::vector<const TrainingSequence*>& train, const AtomTrainingOptions& options,
+                 const ShapeDescriptorOptions& shape) {
+  PostureAtoms atoms;
+  atoms.descriptor = shape;
+  atoms.names = AtomNames();
+  atoms.weights = options.weights;
+  atoms.rule = options.rule;
+  const int bins = shape.bin_count();
+  // A0: the persons' resting postures, averaged.
+  std::vector<double> rest(bins, 0.0);
+  for (const TrainingSequence* s : train) {
+    for (int i = 0; i < bins; ++i) rest[i] += s->own_rest[i];
+  }
+  double norm = 0;
+  for (double v : rest) norm += v * v;
+  atoms.rest.resize(bins);
+  for (int i = 0; i < bins; ++i) atoms.rest[i] = static_cast<float>(rest[i] / std::sqrt(norm));
+  // The arm atoms: mean residuals of the one-arm frames.
+  for (int k = 1; k < static_cast<int>(atoms.names.size()); ++k) {
+    std::vector<double> sum(bins, 0.0);
+    int count = 0;
+    for (const TrainingSequence* s : train) {
+      for (size_t f = 0; f < s->frames.size(); ++f) {
+        if (s->pairs[f] != std::array<int, 2>{0, k}) continue;
+        double alpha0 = 0;
+        const std::vector<float> r = RestResidual(s->frames[f].Dense(bins), s->own_rest, &alpha0);
+        for (int i = 0; i < bins; ++i) sum[i] += r[i];
+        ++count;
+      }
+    }
+    if (count == 0) {
+      throw InputError(train.front()->name, "truth", "no frame shows one arm in atom " + atoms.names[k]);
+    }
+    std::vector<float> arm(bins);
+    for (int i = 0; i < bins; ++i) arm[i] = static_cast<float>(sum[i] / count);
+    atoms.arms.push_back(arm);
+  }
+  // Scale each atom so that one arm in its posture weighs 1 on average (alpha'_i).
+  std::vector<std::vector<std::vector<double>>> weights;
+  for (const TrainingSequence* s : train) weights.push_back(Weights(atoms, *s));
+  for (size_t k = 0; k < atoms.arms.size(); ++k) {
+    double sum = 0;
+    int count = 0;
+    for (size_t q = 0; q < train.size(); ++q) {
+      for (size_t f = 0; f < train[q]->frames.size(); ++f) {
+        if (train[q]->pairs[f] != std::array<int, 2>{0, static_cast<int>(k) + 1}) continue;
+        sum += weights[q][f][k];
+        ++count;
+      }
+    }
+    const double scale = count && sum > 0 ? sum / count : 1.0;
+    for (float& v : atoms.arms[k]) v = static_cast<float>(v * scale);
+  }
+  weights.clear();
+  for (const TrainingSequence* s : train) weights.push_back(Weights(atoms, *s));
+  // The centroids of every pair's weights.
+  std::map<std::array<int, 2>, std::pair<std::vector<double>, int>> sums;
+  for (size_t q = 0; q < train.size(); ++q) {
+    for (size_t f = 0; f < train[q]->frames.size(); ++f) {
+      auto& [sum, count] = sums[train[q]->pairs[f]];
+      sum.resize(atoms.arms.size(), 0.0);
+      for (size_t k = 0; k < sum.size(); ++k) sum[k] += weights[q][f][k];
+      ++count;
+    }
+  }
+  for (auto& [pair, sc] : sums) {
+    for (double& v : sc.first) v /= sc.second;
+    atoms.centroids.emplace_back(PairName(pair, atoms), sc.first);
+  }
+  // The thresholds: the best on the training frames.
+  const PairRule rule = atoms.rule;
+  atoms.rule = PairRule::kThresholds;
+  double best = -1;
+  double best_presence = atoms.presence, best_instance = atoms.instance;
+  for (double presence = 0.2; presence < 0.81; presence += 0.05) {
+    for (double instance = 1.2; instance < 2.21; instance += 0.1) {
+      atoms.presence = presence;
+      atoms.instance = instance;
+      const double acc = Accuracy(atoms, train, weights);
+      if (acc > best + 1e-12) best = acc, best_presence = presence, best_instance = instance;
+    }
+  }
+  atoms.presence = std::round(best_presence * 100) / 100;
+  atoms.instance = std::round(best_instance * 100) / 100;
+  atoms.rule = rule;
+  return atoms;
+}
+
+double AccuracyOn(const PostureAtoms& atoms, const std::vector<const TrainingSequence*>& seqs) {
+  std::vector<std::vector<std::vector<double>>> weights;
+  for (const TrainingSequence* s : seqs) weights.push_back(Weights(atoms, *s));
+  return Accuracy(atoms, seqs, weights);
+}
+
+}  // namespace
+
+AtomTrainingResult RunAtomTraining(const AtomTrainingOptions& options) {
+  if (options.sequences.empty()) throw InputError("", "SEQ", "give at least one rendered sequence");
+  const ShapeDescriptorOptions shape;
+  std::vector<TrainingSequence> seqs;
+  for (const fs::path& dir : options.sequences) {
+    if (!HasManifest(dir)) throw InputError(dir.string(), "manifest.json", "not a rendered sequence");
+    seqs.push_back(ReadSequence(dir, shape));
+    Log().info("train atoms: {}: {} frames", seqs.back().name, seqs.back().frames.size());
+  }
+  std::vector<const TrainingSequence*> all;
+  for (const auto& s : seqs) all.push_back(&s);
+  AtomTrainingResult result;
+  for (const auto& s : seqs) result.frames += static_cast<int>(s.frames.size());
+  PostureAtoms atoms = Fit(all, options, shape);
+  result.training_accuracy = AccuracyOn(atoms, all);
+  if (options.cross_validate && seqs.size() > 1) {
+    for (size_t q = 0; q < seqs.size(); ++q) {
+      std::vector<const TrainingSequence*> others;
+      for (size_t r = 0; r < seqs.size(); ++r) {
+        if (r != q) others.push_back(&seqs[r]);
+      }
+      const PostureAtoms held = Fit(others, options, shape);
+      result.held_out.emplace_back(seqs[q].name, AccuracyOn(held, {&seqs[q]}));
+      Log().info("train atoms: {} held out: {:.1f}% of its frames' pairs right", seqs[q].name,
+                 100 * result.held_out.back().second);
+    }
+  }
+  nlohmann::json sequences = nlohmann::json::array();
+  for (const auto& s : seqs) sequences.push_back(s.about);
+  nlohmann::json held_out = nlohmann::json::object();
+  for (const auto& [name, acc] : result.held_out) held_out[name] = std::round(acc * 1e4) / 1e4;
+  atoms.provenance = {{"made_by", "irbench train atoms"},
+                      {"tool_version", ToolVersion()},
+                      {"sequences", sequences},
+                      {"frames", result.frames},
+                      {"rest", "each person's own: the mean descriptor over the truth's both-arms-at-rest frames"},
+                      {"training_accuracy", std::round(result.training_accuracy * 1e4) / 1e4},
+                      {"held_out_accuracy", held_out}};
+  result.model = options.out.empty() ? DefaultPostureAtomsPath() : options.out;
+  atoms.Save(result.model);
+  return result;
+}
+
+}  // namespace irbench
