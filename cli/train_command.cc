@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ci/train/atom_training.h"
+#include "ci/train/gesture_training.h"
 #include "ci/train/rest_training.h"
 #include "cli/commands.h"
 #include "cli/option_checks.h"
@@ -54,6 +55,33 @@ int RunTrainAtoms(const CLI::App& cmd, TrainAtomsArgs& args) {
   return kExitOk;
 }
 
+// What `irbench train gestures`' flags bind to.
+struct TrainGesturesArgs {
+  GestureTrainingJob job;
+  std::vector<std::string> train, test;
+  std::string atoms, out, table;
+};
+
+int RunTrainGestures(const CLI::App& cmd, TrainGesturesArgs& args) {
+  RequireNotEmpty(cmd, "--out", args.out);
+  GestureTrainingJob& job = args.job;
+  for (const std::string& s : args.train) job.train.emplace_back(s);
+  for (const std::string& s : args.test) job.test.emplace_back(s);
+  job.posture_atoms = args.atoms;
+  job.out = args.out;
+  job.table = args.table;
+  const GestureTrainingResult r = RunGestureTraining(job);
+  std::cout << "gesture models: " << r.segments << " training segments\n";
+  if (!r.evaluation.counts.empty()) {
+    std::cout << r.evaluation.Markdown();
+    for (const char* kind : {"hmm", "pahmm", "fhmm"}) {
+      std::cout << kind << ": mean identification rate " << 100 * r.evaluation.MeanRate(kind) << "%\n";
+    }
+  }
+  std::cout << r.model.string() << "\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 std::vector<Command> AddTrainCommand(CLI::App& app) {
@@ -97,7 +125,31 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   atoms_cmd->add_flag("!--no-cross-validation", atom_args->job.cross_validate,
                       "skip the leave-one-sequence-out accuracies");
   atoms_cmd->add_option("--out", atom_args->out, "model file (default: tracker/models/posture_atoms.json)");
+  auto gesture_args = std::make_shared<TrainGesturesArgs>();
+  CLI::App* gestures_cmd = train_cmd->add_subcommand(
+      "gestures",
+      "Gesture models (thesis 5.2): HMM, PaHMM and FHMM per gesture over the posture decomposition,\n"
+      "from rendered gesture sessions (irbench render --motion gesture_set) tracked by the tracker;\n"
+      "with --test or --leave-one-out, the identification rates of Table 5.2");
+  gestures_cmd->add_option("--train", gesture_args->train, "rendered gesture sessions to train on")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  gestures_cmd->add_option("--test", gesture_args->test, "rendered gesture sessions to score the models on")
+      ->check(CLI::ExistingDirectory);
+  gestures_cmd->add_flag("--leave-one-out", gesture_args->job.leave_one_out,
+                         "score each --train session with models trained on the others");
+  gestures_cmd->add_option("--posture-atoms", gesture_args->atoms,
+                           "posture atoms (default: tracker/models/posture_atoms.json)");
+  gestures_cmd->add_option("--restarts", gesture_args->job.options.restarts, "EM starts per model")
+      ->capture_default_str()
+      ->transform(IntegerIn(1, 100));
+  gestures_cmd->add_option("--seed", gesture_args->job.options.seed, "seed of the EM starts")
+      ->capture_default_str()
+      ->transform(Uint64Text());
+  gestures_cmd->add_option("--table", gesture_args->table, "also write the tables as Markdown to this file");
+  gestures_cmd->add_option("--out", gesture_args->out, "model file (default: tracker/models/gesture_models.json)");
   return {{cmd, [cmd, args] { return RunTrainRest(*cmd, *args); }},
+          {gestures_cmd, [gestures_cmd, gesture_args] { return RunTrainGestures(*gestures_cmd, *gesture_args); }},
           {atoms_cmd, [atoms_cmd, atom_args] { return RunTrainAtoms(*atoms_cmd, *atom_args); }}};
 }
 

@@ -142,6 +142,17 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
   std::map<std::string, std::vector<double>> joint_errors, pointing_errors;
   std::map<std::string, std::vector<int>> joint_frames, pointing_frames;
   std::map<std::string, int> joint_missing, pointing_missing;
+  // The truth's current gesture run and the track's latest label in it.
+  std::string run_gesture, run_label;
+  auto close_run = [&] {
+    if (!run_gesture.empty()) {
+      const std::string found = run_label.empty() ? "(none)" : run_label;
+      ++score.gesture_confusion[run_gesture][found];
+      ++score.gesture.total;
+      score.gesture.correct += found == run_gesture;
+    }
+    run_label.clear();
+  };
   for (const auto& [frame, truth] : truth_by_frame) {
     if (!Flag(truth, "present", truth_jsonl).value_or(false)) continue;
     ++score.present_frames;
@@ -222,12 +233,22 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       ++score.motion.total;
       score.motion.correct += label == truth_label;
     }
+    // Gestures: the truth's runs and the track's latest label in each.
+    const Json* truth_gesture = truth_labels ? Child(*truth_labels, "gesture") : nullptr;
+    const std::string truth_g = truth_gesture && truth_gesture->is_string() ? truth_gesture->get<std::string>() : "";
+    if (truth_g != run_gesture) {
+      close_run();
+      run_gesture = truth_g;
+    }
+    const Json* track_gesture = track ? Child(*track, "gesture") : nullptr;
+    const Json* label = track_gesture && track_gesture->is_object() ? Child(*track_gesture, "label") : nullptr;
+    if (!run_gesture.empty() && label && label->is_string()) run_label = label->get<std::string>();
     // Postures: unordered atom pairs, whenever the hull gave the tracker one.
     const Json* truth_posture = truth_labels ? Child(*truth_labels, "posture") : nullptr;
     if (truth_posture && truth_posture->is_array() && truth_posture->size() == 2 && (*truth_posture)[0].is_string() &&
         (*truth_posture)[1].is_string()) {
       const std::string truth_pair = PairKey((*truth_posture)[0], (*truth_posture)[1]);
-      const Json* track_posture = Child(*track, "posture");
+      const Json* track_posture = track ? Child(*track, "posture") : nullptr;
       const Json* pair = track_posture && track_posture->is_object() ? Child(*track_posture, "pair") : nullptr;
       if (pair && pair->is_array() && pair->size() == 2 && (*pair)[0].is_string() && (*pair)[1].is_string()) {
         const std::string tracked_pair = PairKey((*pair)[0], (*pair)[1]);
@@ -239,6 +260,7 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       }
     }
   }
+  close_run();
   // One Chauvenet pass per series gives both the summary and the per-frame flags.
   auto summarise = [](const std::vector<double>& errors, const std::vector<int>& frames, int missing,
                       ErrorStats* stats, std::vector<std::tuple<int, double, bool>>* rows) {
@@ -317,6 +339,9 @@ nlohmann::json Score::ToJson() const {
                    {"total", posture.total},
                    {"missing", posture.missing},
                    {"confusion", posture_confusion}};
+  j["gestures"] = {{"identification", gesture.total ? Json(gesture.rate()) : Json(nullptr)},
+                   {"performances", gesture.total},
+                   {"confusion", gesture_confusion}};
   j["silhouettes"] = silhouettes ? silhouettes->ToJson() : Json(nullptr);
   return j;
 }
@@ -358,6 +383,12 @@ std::string Score::Markdown() const {
         << Fixed(100 * posture.rate(), 2) << "% of " << posture.total << " frames right, " << posture.missing
         << " without a posture)\n\n"
         << ConfusionMarkdown(posture_confusion);
+  }
+  if (!gesture_confusion.empty()) {
+    out << "\n**Gestures** (thesis 5.3: each performance the truth marks, identified as the last gesture the track "
+           "reports in it; rows truth, columns identified; "
+        << Fixed(100 * gesture.rate(), 2) << "% of " << gesture.total << " performances)\n\n"
+        << ConfusionMarkdown(gesture_confusion);
   }
   if (silhouettes) out << "\n" << silhouettes->Markdown();
   return out.str();

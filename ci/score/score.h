@@ -77,6 +77,12 @@ struct Score {
   // order); truth pair -> recognised pair -> count.
   std::map<std::string, std::map<std::string, int>> posture_confusion;
   Accuracy posture;
+  // Gestures (thesis 5.3): each run of frames the truth labels with one
+  // gesture is one performance; it is identified when the last gesture the
+  // track reports within it is that gesture ("(none)" when it reports none).
+  // Truth gesture -> identified as -> count.
+  std::map<std::string, std::map<std::string, int>> gesture_confusion;
+  Accuracy gesture;
   // The tracker's silhouettes against the truth masks, when the track folder
   // has them (irbench track writes silhouettes/ beside track.jsonl).
   std::optional<SilhouetteScore> silhouettes;

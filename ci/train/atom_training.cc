@@ -1,5 +1,7 @@
 #include "ci/train/atom_training.h"
 
+#include <Eigen/Core>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -203,6 +205,24 @@ PostureAtoms Fit(const std::vector<const TrainingSequence*>& train, const AtomTr
   for (auto& [pair, sc] : sums) {
     for (double& v : sc.first) v /= sc.second;
     atoms.centroids.emplace_back(PairName(pair, atoms), sc.first);
+  }
+  // Their pooled within-pair covariance, inverted (a small ridge keeps it so).
+  const int k = static_cast<int>(atoms.arms.size());
+  Eigen::MatrixXd scatter = Eigen::MatrixXd::Zero(k, k);
+  long samples = 0;
+  for (size_t q = 0; q < train.size(); ++q) {
+    for (size_t f = 0; f < train[q]->frames.size(); ++f) {
+      const std::vector<double>& mean = sums.at(train[q]->pairs[f]).first;
+      Eigen::VectorXd d(k);
+      for (int i = 0; i < k; ++i) d(i) = weights[q][f][i] - mean[i];
+      scatter += d * d.transpose();
+      ++samples;
+    }
+  }
+  const Eigen::MatrixXd covariance = scatter / std::max<long>(samples - 1, 1) + 1e-4 * Eigen::MatrixXd::Identity(k, k);
+  const Eigen::MatrixXd precision = covariance.inverse();
+  for (int i = 0; i < k; ++i) {
+    for (int j = 0; j < k; ++j) atoms.centroid_precision.push_back(precision(i, j));
   }
   // The thresholds: the best on the training frames.
   const PairRule rule = atoms.rule;

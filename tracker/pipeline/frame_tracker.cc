@@ -238,6 +238,19 @@ FrameTracker::FrameTracker(const SequenceInput& input,
     posture_atoms_path_ = atoms;
     shape_options_ = posture_atoms_->descriptor;
   }
+  const fs::path gestures = settings.gesture_models.empty() ? DefaultGestureModelsPath() : settings.gesture_models;
+  if (!settings.gesture_models.empty() || (posture_atoms_ && fs::exists(gestures))) {
+    if (!posture_atoms_) {
+      throw InputError(gestures.string(), "", "gesture recognition needs posture atoms (--posture-atoms)");
+    }
+    gesture_models_ = std::make_shared<GestureModels>(GestureModels::Load(gestures));
+    if (gesture_models_->atoms != posture_atoms_->names) {
+      throw InputError(gestures.string(), "atoms", "were trained for other posture atoms than " +
+                                                       posture_atoms_path_.string() + "'s");
+    }
+    gesture_models_path_ = gestures;
+    gesture_recognizer_.emplace(gesture_models_, settings.gesture_model);
+  }
 }
 
 FrameTracker::Step FrameTracker::Track(int f,
@@ -283,6 +296,17 @@ FrameTracker::Step FrameTracker::Track(int f,
     user_rest_.Update(step.shape->bins, at_rest);
     step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_);
   }
+  if (gesture_recognizer_) {
+    std::optional<GestureObservation> observation;
+    if (step.posture) {
+      observation.emplace();
+      observation->weights = Eigen::Map<const Eigen::VectorXd>(step.posture->weights.data(), step.posture->weights.size());
+      observation->primary = step.posture->pair[1];
+      observation->secondary = step.posture->pair[0];
+    }
+    const bool at_rest = step.pose && step.pose->rest[0].value_or(false) && step.pose->rest[1].value_or(false);
+    step.gesture = gesture_recognizer_->Update(f, observation, at_rest);
+  }
   const double shape_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shape_start).count();
   nlohmann::json& line = step.features_line;
@@ -297,6 +321,11 @@ FrameTracker::Step FrameTracker::Track(int f,
   line["ms"] = StageMs(step.features, step.pose);
   line["ms"]["shape"] = shape_ms;
   step.track_line["posture"] = PostureJson(step.posture, posture_atoms_.get());
+  if (step.gesture) {
+    step.track_line["gesture"] = {{"label", gesture_models_->gestures[step.gesture->gesture]},
+                                  {"score", std::round(step.gesture->score * 1e3) / 1e3},
+                                  {"start_frame", step.gesture->start_frame}};
+  }
   step.track_line["ms"] = line["ms"];
   step.images = std::move(images);
   return step;

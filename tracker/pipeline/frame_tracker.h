@@ -17,6 +17,7 @@
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/track_settings.h"
 #include "tracker/pose/pose_tracker.h"
+#include "tracker/gesture/gesture_recognizer.h"
 #include "tracker/posture/decompose.h"
 #include "tracker/shape/shape_descriptor.h"
 
@@ -47,6 +48,8 @@ class FrameTracker {
     // Its decomposition into the posture atoms (thesis 5.1.1), when the
     // tracker has atoms and a descriptor.
     std::optional<Posture> posture;
+    // The online gesture decision (thesis 5.2), when the tracker has models.
+    std::optional<GestureDecision> gesture;
     nlohmann::json features_line;  // features.jsonl's line, with "ms"
     nlohmann::json track_line;     // track.jsonl's line, with "ms"
   };
@@ -58,6 +61,8 @@ class FrameTracker {
   double train_ms() const { return train_ms_; }
   // The posture atoms' file in use; empty when posture recognition is off.
   const std::filesystem::path& posture_atoms_path() const { return posture_atoms_path_; }
+  // The gesture models' file in use; empty when gesture recognition is off.
+  const std::filesystem::path& gesture_models_path() const { return gesture_models_path_; }
   const FrontEnd& front_end() const { return front_end_; }
   // Per camera, how many frame-sets it was left out of, by reason.
   const std::vector<std::map<std::string, int>>& left_out_counts() const { return left_out_counts_; }
@@ -71,6 +76,9 @@ class FrameTracker {
   std::filesystem::path posture_atoms_path_;
   std::shared_ptr<const PostureAtoms> posture_atoms_;
   UserRest user_rest_;
+  std::filesystem::path gesture_models_path_;
+  std::shared_ptr<const GestureModels> gesture_models_;
+  std::optional<GestureRecognizer> gesture_recognizer_;
   CameraHealthMonitor health_;
   std::vector<CameraHealth> last_health_;  // per camera, to warn on changes
   std::vector<std::map<std::string, int>> left_out_counts_;

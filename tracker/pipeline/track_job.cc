@@ -108,6 +108,7 @@ void CheckOutputOutsideSequence(const TrackJobOptions& options) {
   }
   inputs.push_back(options.tracker.rest_model.empty() ? DefaultRestModelPath() : options.tracker.rest_model);
   inputs.push_back(options.tracker.posture_atoms.empty() ? DefaultPostureAtomsPath() : options.tracker.posture_atoms);
+  inputs.push_back(options.tracker.gesture_models.empty() ? DefaultGestureModelsPath() : options.tracker.gesture_models);
   CheckOutputApart(out, inputs, "--out");
 }
 
@@ -239,6 +240,11 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   if (!tracker.posture_atoms_path().empty()) {
     models["posture_atoms"] = {{"file", fs::absolute(tracker.posture_atoms_path()).lexically_normal().string()},
                                {"sha256", Sha256OfFile(tracker.posture_atoms_path())}};
+  }
+  if (!tracker.gesture_models_path().empty()) {
+    models["gestures"] = {{"file", fs::absolute(tracker.gesture_models_path()).lexically_normal().string()},
+                          {"sha256", Sha256OfFile(tracker.gesture_models_path())},
+                          {"kind", GestureModelKindName(settings.gesture_model)}};
   }
   meta["models"] = models;
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");

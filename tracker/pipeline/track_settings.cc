@@ -68,6 +68,15 @@ std::vector<TrackSetting> MakeSettings() {
        "posture atoms of the shape descriptor's decomposition (default: tracker/models/posture_atoms.json "
        "when present)",
        PathBinding{[](TrackerSettings& t) -> std::filesystem::path& { return t.posture_atoms; }}});
+  s.push_back(
+      {"gesture_models", "--gesture-models",
+       "gesture models (default: tracker/models/gesture_models.json when present)",
+       PathBinding{[](TrackerSettings& t) -> std::filesystem::path& { return t.gesture_models; }}});
+  s.push_back({"gesture_model", "--gesture-model",
+               "which gesture models recognise: fhmm (factorial), pahmm (parallel) or hmm (25 states)",
+               ChoiceBinding{{"fhmm", "pahmm", "hmm"},
+                             [](const TrackerSettings& t) -> std::string { return GestureModelKindName(t.gesture_model); },
+                             [](TrackerSettings& t, const std::string& v) { t.gesture_model = *ParseGestureModelKind(v); }}});
   s.push_back({"background_model", "--background-model",
                "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)",
                ChoiceBinding{{"flicker", "plain"},

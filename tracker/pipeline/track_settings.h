@@ -16,6 +16,7 @@
 
 #include "common/json_reader.h"
 #include "tracker/frontend/frontend.h"
+#include "tracker/gesture/gesture_models.h"
 #include "tracker/pose/pose_tracker.h"
 
 namespace irbench {
@@ -39,6 +40,11 @@ struct TrackerSettings {
   // The posture atoms (irbench train atoms); empty: the default model
   // (tracker/models/posture_atoms.json) when it exists, else posture stays null.
   std::filesystem::path posture_atoms;
+  // The gesture models (irbench train gestures) and which kind recognises;
+  // empty path: the default model (tracker/models/gesture_models.json) when
+  // it and the posture atoms exist, else gesture stays null.
+  std::filesystem::path gesture_models;
+  GestureModelKind gesture_model = GestureModelKind::kFactorialHmm;
 };
 
 // The binding kinds. `ref` gives the setting's field in a TrackerSettings.

@@ -109,7 +109,16 @@ std::array<int, 2> PairFromWeights(const std::vector<double>& arm_weights, const
     std::array<int, 2> pair{0, 0};
     for (const auto& [name, centroid] : atoms.centroids) {
       double d = 0;
-      for (size_t k = 0; k < centroid.size(); ++k) d += (arm_weights[k] - centroid[k]) * (arm_weights[k] - centroid[k]);
+      const size_t n = centroid.size();
+      if (atoms.centroid_precision.size() == n * n) {
+        for (size_t i = 0; i < n; ++i) {
+          for (size_t j = 0; j < n; ++j) {
+            d += (arm_weights[i] - centroid[i]) * atoms.centroid_precision[i * n + j] * (arm_weights[j] - centroid[j]);
+          }
+        }
+      } else {
+        for (size_t k = 0; k < n; ++k) d += (arm_weights[k] - centroid[k]) * (arm_weights[k] - centroid[k]);
+      }
       if (d >= best) continue;
       const size_t plus = name.find('+');
       const int a = IndexOfName(atoms, name.substr(0, plus));

@@ -72,6 +72,9 @@ void PostureAtoms::Check(const std::string& file) const {
     throw InputError(file, "instance", "must be above presence, and presence above 0");
   }
   if (rule == PairRule::kCentroids && centroids.empty()) throw InputError(file, "centroids", "needs at least one pair");
+  if (!centroid_precision.empty() && centroid_precision.size() != arms.size() * arms.size()) {
+    throw InputError(file, "centroid_precision", "needs K x K values for the K arm atoms");
+  }
   for (size_t c = 0; c < centroids.size(); ++c) {
     if (centroids[c].second.size() != arms.size()) {
       throw InputError(file, "centroids[" + std::to_string(c) + "]", "needs one weight per arm atom");
@@ -82,7 +85,7 @@ void PostureAtoms::Check(const std::string& file) const {
 PostureAtoms PostureAtoms::Load(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
   root.CheckKeys({"format", "descriptor", "names", "rest", "arms", "weights", "iterations", "overlap_threshold", "rule",
-                  "presence", "instance", "centroids", "provenance"});
+                  "presence", "instance", "centroids", "centroid_precision", "provenance"});
   if (root.GetString("format") != kFormat) {
     root["format"].Fail("must be " + std::string(kFormat) + " (got " + root.GetString("format") + ")");
   }
@@ -129,6 +132,7 @@ PostureAtoms PostureAtoms::Load(const std::filesystem::path& path) {
   a.instance = root.GetDouble("instance");
   const JsonNode centroids = root["centroids"];
   for (const std::string& pair : centroids.Keys()) a.centroids.emplace_back(pair, centroids[pair].Numbers());
+  if (root.Has("centroid_precision")) a.centroid_precision = root["centroid_precision"].Numbers();
   a.provenance = root.Has("provenance") ? root["provenance"].raw() : nlohmann::json::object();
   a.Check(path.string());
   return a;
@@ -161,6 +165,7 @@ void PostureAtoms::Save(const std::filesystem::path& path) const {
     c[pair] = row;
   }
   j["centroids"] = c;
+  if (!centroid_precision.empty()) j["centroid_precision"] = centroid_precision;
   j["rest"] = SparseJson(rest);
   j["arms"] = nlohmann::json::array();
   for (const auto& arm : arms) j["arms"].push_back(SparseJson(arm));

@@ -34,7 +34,7 @@ enum class AtomWeights {
 // How the pair follows from the weights.
 enum class PairRule {
   kThresholds,  // the thesis's: atoms above `presence`, two instances above `instance`
-  kCentroids,   // the nearest of the training pairs' mean weight vectors
+  kCentroids,   // the nearest of the training pairs' mean weight vectors (linear discriminants)
 };
 
 const char* AtomWeightsName(AtomWeights w);
@@ -56,6 +56,10 @@ struct PostureAtoms {
   // Centroids rule: per pair ("A1+A3", names in order), its mean arm-atom
   // weights over the training frames.
   std::vector<std::pair<std::string, std::vector<double>>> centroids;
+  // ... and the distance to them: Mahalanobis with this precision (the
+  // inverse of the pairs' pooled within-pair covariance of the weights; K x K
+  // row-major, K the arm atoms), Euclidean when empty.
+  std::vector<double> centroid_precision;
   nlohmann::json provenance;  // how the file was made
 
   int atom_count() const { return static_cast<int>(names.size()); }

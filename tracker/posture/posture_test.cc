@@ -141,6 +141,13 @@ TEST(Posture, PairRules) {
   EXPECT_EQ(PairFromWeights({0.1, 0.0, 0.0, 0.0}, a), (std::array<int, 2>{0, 0}));
   EXPECT_EQ(PairFromWeights({1.7, 0.1, 0.0, 0.0}, a), (std::array<int, 2>{1, 1}));
   EXPECT_EQ(PairFromWeights({0.8, 0.1, 0.9, 0.0}, a), (std::array<int, 2>{1, 3}));
+  // Mahalanobis: a precision that discounts atom A2's weight moves the choice.
+  a.centroids = {{"A0+A0", {0, 0, 0, 0}}, {"A1+A2", {1, 1, 0, 0}}};
+  EXPECT_EQ(PairFromWeights({0.6, 0.0, 0.0, 0.0}, a), (std::array<int, 2>{0, 0}));
+  a.centroid_precision = {1, 0, 0, 0, 0, 0.01, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  EXPECT_EQ(PairFromWeights({0.6, 0.0, 0.0, 0.0}, a), (std::array<int, 2>{1, 2}));
+  a.centroid_precision = {1, 2};
+  EXPECT_THROW(a.Check("x.json"), InputError);
 }
 
 TEST(Posture, DecomposeUsesTheUsersRest) {

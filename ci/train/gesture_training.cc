@@ -1,0 +1,256 @@
+#include "ci/train/gesture_training.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/json_reader.h"
+#include "common/logging.h"
+#include "common/paths.h"
+#include "common/progress.h"
+#include "sequence_format/manifest.h"
+#include "tracker/io/sequence_input.h"
+#include "tracker/pipeline/frame_tracker.h"
+
+namespace irbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The six gestures of thesis 5.3 in its order (the sim's names).
+const std::vector<std::string>& Gestures() {
+  static const std::vector<std::string> names = {"point_horizontal", "flap_both",      "direct_traffic",
+                                                 "raise_overhead",   "flap_one",       "point_diagonal_both"};
+  return names;
+}
+
+// Thesis Tables 5.2 (FHMM) and 5.3 (HMM): identification rates (%) per
+// gesture (rows, in Gestures() order) and person 1-5 (person 1 trained on).
+constexpr double kThesisFhmm[6][5] = {{45, 50, 30.77, 23.08, 50.0},  {87.5, 87.5, 83.3, 88.9, 90.0},
+                                      {100, 100, 25.0, 87.5, 100},   {100, 92.3, 75.0, 80.0, 100},
+                                      {76.6, 66.6, 83.3, 100, 85.7}, {100, 100, 55.5, 100, 100}};
+constexpr double kThesisHmm[6][5] = {{37.5, 50, 76.9, 44, 80.0},  {87.5, 87.5, 100, 55.5, 100},
+                                     {41.6, 41.6, 0, 37.5, 66.6}, {80.0, 87.5, 75, 10, 91.6},
+                                     {88.8, 88.8, 100, 100, 100}, {22.2, 22.2, 11.1, 7.8, 0}};
+
+// A sequence as the tracker saw it: per frame its posture (or none) and
+// the truth's gesture spans.
+struct TrackedSession {
+  std::string person;
+  std::vector<std::optional<GestureObservation>> frames;
+  struct Span {
+    int gesture, first, last;
+  };
+  std::vector<Span> spans;
+
+  std::vector<GestureObservation> Segment(const Span& s) const {
+    std::vector<GestureObservation> out;
+    for (int f = std::max(0, s.first); f <= s.last && f < static_cast<int>(frames.size()); ++f) {
+      if (frames[f]) out.push_back(*frames[f]);
+    }
+    return out;
+  }
+};
+
+TrackedSession Track(const fs::path& dir, const fs::path& atoms) {
+  TrackedSession s;
+  const Manifest manifest = ReadManifest(dir);
+  s.person = manifest.avatar.empty() ? dir.filename().string() : manifest.avatar;
+  const fs::path events_file = dir / "truth" / "events.json";
+  const JsonNode events = ParseJsonFile(events_file.string());
+  for (size_t i = 0; i < events.Size(); ++i) {
+    if (events[i].GetString("kind") != "gesture") continue;
+    const std::string name = events[i].GetString("value");
+    const auto it = std::find(Gestures().begin(), Gestures().end(), name);
+    if (it == Gestures().end()) events[i]["value"].Fail("unknown gesture '" + name + "'");
+    s.spans.push_back({static_cast<int>(it - Gestures().begin()), events[i].GetInt("start_frame"),
+                       events[i].GetInt("end_frame")});
+  }
+  if (s.spans.empty()) throw InputError(events_file.string(), "", "no gesture events: not a gesture session");
+  const SequenceInput input = SequenceInput::Open(dir);
+  TrackerSettings settings;
+  settings.posture_atoms = atoms;
+  FrameTracker tracker(input, settings, EffectiveFrontEndOptions(settings), LoadRestClassifier(settings));
+  Progress progress("train gestures: " + dir.filename().string(), "frame-sets", input.frame_count());
+  for (int f = 0; f < input.frame_count(); ++f) {
+    std::vector<std::string> problems;
+    const FrameTracker::Step step = tracker.Track(f, input.TryFrameSet(f, &problems), problems, 1.0 / input.fps());
+    progress.Set(f + 1, "frame");
+    if (!step.posture) {
+      s.frames.push_back(std::nullopt);
+      continue;
+    }
+    GestureObservation o;
+    o.weights = Eigen::Map<const Eigen::VectorXd>(step.posture->weights.data(), step.posture->weights.size());
+    o.primary = step.posture->pair[1];
+    o.secondary = step.posture->pair[0];
+    s.frames.push_back(o);
+  }
+  return s;
+}
+
+std::vector<std::vector<std::vector<GestureObservation>>> SegmentsOf(const std::vector<const TrackedSession*>& sessions) {
+  std::vector<std::vector<std::vector<GestureObservation>>> segments(Gestures().size());
+  for (const TrackedSession* s : sessions) {
+    for (const auto& span : s->spans) {
+      std::vector<GestureObservation> seg = s->Segment(span);
+      if (!seg.empty()) segments[span.gesture].push_back(std::move(seg));
+    }
+  }
+  return segments;
+}
+
+void Evaluate(const GestureModels& models, const TrackedSession& test, GestureEvaluation* e) {
+  for (GestureModelKind kind : {GestureModelKind::kHmm, GestureModelKind::kParallelHmm, GestureModelKind::kFactorialHmm}) {
+    const std::string k = GestureModelKindName(kind);
+    for (const auto& span : test.spans) {
+      const std::vector<GestureObservation> seg = test.Segment(span);
+      const std::string& truth = Gestures()[span.gesture];
+      auto& c = e->counts[k][test.person][truth];
+      ++c.second;
+      if (seg.empty()) {
+        ++e->confusion[k][truth]["(no posture)"];
+        continue;
+      }
+      const int found = models.Classify(kind, seg);
+      c.first += found == span.gesture;
+      ++e->confusion[k][truth][Gestures()[found]];
+    }
+  }
+}
+
+std::string Percent(double v) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "%.1f", v);
+  return buf;
+}
+
+}  // namespace
+
+double GestureEvaluation::MeanRate(const std::string& kind) const {
+  const auto k = counts.find(kind);
+  if (k == counts.end() || k->second.empty()) return 0;
+  double sum = 0;
+  for (const auto& [person, per_gesture] : k->second) {
+    double rates = 0;
+    int n = 0;
+    for (const auto& [g, c] : per_gesture) {
+      if (c.second == 0) continue;
+      rates += double(c.first) / c.second;
+      ++n;
+    }
+    sum += n ? rates / n : 0;
+  }
+  return sum / k->second.size();
+}
+
+std::string GestureEvaluation::Markdown() const {
+  std::ostringstream out;
+  for (const auto& [kind, per_person] : counts) {
+    out << "**" << kind << "**: identification rate (%) per gesture and test person; mean over persons "
+        << Percent(100 * MeanRate(kind)) << "%";
+    if (kind == "fhmm" || kind == "hmm") out << " (thesis, persons 2-5: " << (kind == "fhmm" ? "Table 5.2" : "Table 5.3") << ")";
+    out << "\n\n| Gesture |";
+    for (const auto& [person, _] : per_person) out << " " << person << " |";
+    if (kind == "fhmm" || kind == "hmm") out << " thesis |";
+    out << "\n|---|";
+    for (size_t i = 0; i < per_person.size(); ++i) out << "---|";
+    if (kind == "fhmm" || kind == "hmm") out << "---|";
+    out << "\n";
+    for (size_t g = 0; g < Gestures().size(); ++g) {
+      out << "| " << g + 1 << " " << Gestures()[g] << " |";
+      for (const auto& [person, per_gesture] : per_person) {
+        const auto c = per_gesture.find(Gestures()[g]);
+        if (c == per_gesture.end() || c->second.second == 0) {
+          out << " – |";
+        } else {
+          out << " " << Percent(100.0 * c->second.first / c->second.second) << " (" << c->second.first << "/"
+              << c->second.second << ") |";
+        }
+      }
+      if (kind == "fhmm" || kind == "hmm") {
+        const auto& t = kind == "fhmm" ? kThesisFhmm : kThesisHmm;
+        out << " " << Percent((t[g][1] + t[g][2] + t[g][3] + t[g][4]) / 4) << " |";
+      }
+      out << "\n";
+    }
+    out << "\nConfusion (" << kind << "; rows truth, columns recognised):\n\n| |";
+    std::vector<std::string> cols = Gestures();
+    cols.push_back("(no posture)");
+    for (const auto& c : cols) out << " " << c << " |";
+    out << "\n|---|";
+    for (size_t i = 0; i < cols.size(); ++i) out << "---|";
+    out << "\n";
+    const auto& conf = confusion.at(kind);
+    for (const std::string& t : Gestures()) {
+      const auto row = conf.find(t);
+      if (row == conf.end()) continue;
+      out << "| " << t << " |";
+      for (const auto& c : cols) {
+        const auto n = row->second.find(c);
+        out << " " << (n == row->second.end() ? 0 : n->second) << " |";
+      }
+      out << "\n";
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
+  if (job.train.empty()) throw InputError("", "--train", "give at least one rendered gesture session");
+  const fs::path atoms = job.posture_atoms.empty() ? DefaultPostureAtomsPath() : job.posture_atoms;
+  if (!fs::exists(atoms)) {
+    throw InputError(atoms.string(), "", "no posture atoms (irbench train atoms writes them)");
+  }
+  const PostureAtoms atom_model = PostureAtoms::Load(atoms);
+  std::vector<TrackedSession> train, test;
+  for (const fs::path& dir : job.train) train.push_back(Track(dir, atoms));
+  for (const fs::path& dir : job.test) test.push_back(Track(dir, atoms));
+  std::vector<const TrackedSession*> all;
+  for (const auto& s : train) all.push_back(&s);
+  GestureTrainingResult result;
+  GestureModels models = GestureModels::Train(Gestures(), atom_model.names, SegmentsOf(all), job.options);
+  for (const auto& per_gesture : SegmentsOf(all)) result.segments += static_cast<int>(per_gesture.size());
+  result.evaluation.gestures = Gestures();
+  if (job.leave_one_out) {
+    for (size_t q = 0; q < train.size(); ++q) {
+      std::vector<const TrackedSession*> others;
+      for (size_t r = 0; r < train.size(); ++r) {
+        if (r != q) others.push_back(&train[r]);
+      }
+      const GestureModels held = GestureModels::Train(Gestures(), atom_model.names, SegmentsOf(others), job.options);
+      Evaluate(held, train[q], &result.evaluation);
+    }
+  } else {
+    for (const auto& t : test) Evaluate(models, t, &result.evaluation);
+  }
+  nlohmann::json persons = nlohmann::json::array();
+  for (const auto& s : train) persons.push_back(s.person);
+  models.provenance = {{"made_by", "irbench train gestures"},
+                       {"tool_version", ToolVersion()},
+                       {"trained_on", persons},
+                       {"sequences", [&] {
+                          nlohmann::json a = nlohmann::json::array();
+                          for (const fs::path& p : job.train) a.push_back(p.filename().string());
+                          return a;
+                        }()},
+                       {"segments", result.segments},
+                       {"posture_atoms", atoms.filename().string()},
+                       {"options",
+                        {{"hmm_states", job.options.hmm_states},
+                         {"chain_states", job.options.chain_states},
+                         {"restarts", job.options.restarts},
+                         {"max_iterations", job.options.max_iterations},
+                         {"covariance_ridge", job.options.covariance_ridge},
+                         {"pseudo_count", job.options.pseudo_count},
+                         {"seed", job.options.seed}}}};
+  result.model = job.out.empty() ? DefaultGestureModelsPath() : job.out;
+  models.Save(result.model);
+  if (!job.table.empty() && !result.evaluation.counts.empty()) AtomicWriteFile(job.table, result.evaluation.Markdown());
+  return result;
+}
+
+}  // namespace irbench
