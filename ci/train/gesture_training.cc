@@ -102,6 +102,24 @@ std::vector<std::vector<std::vector<GestureObservation>>> SegmentsOf(const std::
   return segments;
 }
 
+// The models of the gestures the sessions perform (a warning for the others).
+GestureModels TrainPresent(const std::vector<std::string>& atoms, const std::vector<const TrackedSession*>& sessions,
+                           const GestureTrainingOptions& options) {
+  const auto segments = SegmentsOf(sessions);
+  std::vector<std::string> names;
+  std::vector<std::vector<std::vector<GestureObservation>>> present;
+  for (size_t g = 0; g < segments.size(); ++g) {
+    if (segments[g].empty()) {
+      Log().warn("train gestures: no performance of {} to train on; it is left out", Gestures()[g]);
+      continue;
+    }
+    names.push_back(Gestures()[g]);
+    present.push_back(segments[g]);
+  }
+  if (names.empty()) throw InputError("", "--train", "the sessions perform no gesture");
+  return GestureModels::Train(names, atoms, present, options);
+}
+
 void Evaluate(const GestureModels& models, const TrackedSession& test, GestureEvaluation* e) {
   for (GestureModelKind kind : {GestureModelKind::kHmm, GestureModelKind::kParallelHmm, GestureModelKind::kFactorialHmm}) {
     const std::string k = GestureModelKindName(kind);
@@ -114,9 +132,9 @@ void Evaluate(const GestureModels& models, const TrackedSession& test, GestureEv
         ++e->confusion[k][truth]["(no posture)"];
         continue;
       }
-      const int found = models.Classify(kind, seg);
-      c.first += found == span.gesture;
-      ++e->confusion[k][truth][Gestures()[found]];
+      const std::string found = models.gestures[models.Classify(kind, seg)];
+      c.first += found == truth;
+      ++e->confusion[k][truth][found];
     }
   }
 }
@@ -212,16 +230,16 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
   std::vector<const TrackedSession*> all;
   for (const auto& s : train) all.push_back(&s);
   GestureTrainingResult result;
-  GestureModels models = GestureModels::Train(Gestures(), atom_model.names, SegmentsOf(all), job.options);
+  GestureModels models = TrainPresent(atom_model.names, all, job.options);
   for (const auto& per_gesture : SegmentsOf(all)) result.segments += static_cast<int>(per_gesture.size());
-  result.evaluation.gestures = Gestures();
+  result.evaluation.gestures = models.gestures;
   if (job.leave_one_out) {
     for (size_t q = 0; q < train.size(); ++q) {
       std::vector<const TrackedSession*> others;
       for (size_t r = 0; r < train.size(); ++r) {
         if (r != q) others.push_back(&train[r]);
       }
-      const GestureModels held = GestureModels::Train(Gestures(), atom_model.names, SegmentsOf(others), job.options);
+      const GestureModels held = TrainPresent(atom_model.names, others, job.options);
       Evaluate(held, train[q], &result.evaluation);
     }
   } else {
