@@ -133,6 +133,59 @@ const std::vector<std::string>& ScoredJoints() {
   return joints;
 }
 
+namespace {
+
+// Postures (thesis 5.1): the truth's pair against the track's, unordered,
+// whenever the hull gave the tracker one.
+void ScorePosture(const Json* truth_labels, const Json* track, Score* score) {
+  const Json* truth_posture = truth_labels ? Child(*truth_labels, "posture") : nullptr;
+  if (!truth_posture || !truth_posture->is_array() || truth_posture->size() != 2 || !(*truth_posture)[0].is_string() ||
+      !(*truth_posture)[1].is_string()) {
+    return;
+  }
+  const std::string truth_pair = PairKey((*truth_posture)[0], (*truth_posture)[1]);
+  const Json* track_posture = track ? Child(*track, "posture") : nullptr;
+  const Json* pair = track_posture && track_posture->is_object() ? Child(*track_posture, "pair") : nullptr;
+  if (!pair || !pair->is_array() || pair->size() != 2 || !(*pair)[0].is_string() || !(*pair)[1].is_string()) {
+    ++score->posture.missing;
+    return;
+  }
+  const std::string tracked_pair = PairKey((*pair)[0], (*pair)[1]);
+  ++score->posture_confusion[truth_pair][tracked_pair];
+  ++score->posture.total;
+  score->posture.correct += tracked_pair == truth_pair;
+}
+
+// Gestures (thesis 5.3): the truth's runs of one gesture label, each
+// identified as the last label the track reports within it.
+struct GestureRuns {
+  Score* score;
+  std::string gesture, label;  // the current run's truth and latest tracked label
+
+  void Add(const Json* truth_labels, const Json* track) {
+    const Json* truth_gesture = truth_labels ? Child(*truth_labels, "gesture") : nullptr;
+    const std::string truth = truth_gesture && truth_gesture->is_string() ? truth_gesture->get<std::string>() : "";
+    if (truth != gesture) {
+      Close();
+      gesture = truth;
+    }
+    const Json* track_gesture = track ? Child(*track, "gesture") : nullptr;
+    const Json* found = track_gesture && track_gesture->is_object() ? Child(*track_gesture, "label") : nullptr;
+    if (!gesture.empty() && found && found->is_string()) label = found->get<std::string>();
+  }
+  void Close() {
+    if (!gesture.empty()) {
+      const std::string found = label.empty() ? "(none)" : label;
+      ++score->gesture_confusion[gesture][found];
+      ++score->gesture.total;
+      score->gesture.correct += found == gesture;
+    }
+    label.clear();
+  }
+};
+
+}  // namespace
+
 Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const ScoreOptions& options) {
   std::map<int, Json> truth_by_frame, track_by_frame;
   const std::vector<Json> truth_lines = ReadJsonLines(truth_jsonl, &truth_by_frame);
@@ -142,17 +195,7 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
   std::map<std::string, std::vector<double>> joint_errors, pointing_errors;
   std::map<std::string, std::vector<int>> joint_frames, pointing_frames;
   std::map<std::string, int> joint_missing, pointing_missing;
-  // The truth's current gesture run and the track's latest label in it.
-  std::string run_gesture, run_label;
-  auto close_run = [&] {
-    if (!run_gesture.empty()) {
-      const std::string found = run_label.empty() ? "(none)" : run_label;
-      ++score.gesture_confusion[run_gesture][found];
-      ++score.gesture.total;
-      score.gesture.correct += found == run_gesture;
-    }
-    run_label.clear();
-  };
+  GestureRuns gestures{&score};
   for (const auto& [frame, truth] : truth_by_frame) {
     if (!Flag(truth, "present", truth_jsonl).value_or(false)) continue;
     ++score.present_frames;
@@ -233,34 +276,10 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       ++score.motion.total;
       score.motion.correct += label == truth_label;
     }
-    // Gestures: the truth's runs and the track's latest label in each.
-    const Json* truth_gesture = truth_labels ? Child(*truth_labels, "gesture") : nullptr;
-    const std::string truth_g = truth_gesture && truth_gesture->is_string() ? truth_gesture->get<std::string>() : "";
-    if (truth_g != run_gesture) {
-      close_run();
-      run_gesture = truth_g;
-    }
-    const Json* track_gesture = track ? Child(*track, "gesture") : nullptr;
-    const Json* label = track_gesture && track_gesture->is_object() ? Child(*track_gesture, "label") : nullptr;
-    if (!run_gesture.empty() && label && label->is_string()) run_label = label->get<std::string>();
-    // Postures: unordered atom pairs, whenever the hull gave the tracker one.
-    const Json* truth_posture = truth_labels ? Child(*truth_labels, "posture") : nullptr;
-    if (truth_posture && truth_posture->is_array() && truth_posture->size() == 2 && (*truth_posture)[0].is_string() &&
-        (*truth_posture)[1].is_string()) {
-      const std::string truth_pair = PairKey((*truth_posture)[0], (*truth_posture)[1]);
-      const Json* track_posture = track ? Child(*track, "posture") : nullptr;
-      const Json* pair = track_posture && track_posture->is_object() ? Child(*track_posture, "pair") : nullptr;
-      if (pair && pair->is_array() && pair->size() == 2 && (*pair)[0].is_string() && (*pair)[1].is_string()) {
-        const std::string tracked_pair = PairKey((*pair)[0], (*pair)[1]);
-        ++score.posture_confusion[truth_pair][tracked_pair];
-        ++score.posture.total;
-        score.posture.correct += tracked_pair == truth_pair;
-      } else {
-        ++score.posture.missing;
-      }
-    }
+    gestures.Add(truth_labels, track);
+    ScorePosture(truth_labels, track, &score);
   }
-  close_run();
+  gestures.Close();
   // One Chauvenet pass per series gives both the summary and the per-frame flags.
   auto summarise = [](const std::vector<double>& errors, const std::vector<int>& frames, int missing,
                       ErrorStats* stats, std::vector<std::tuple<int, double, bool>>* rows) {

@@ -97,6 +97,36 @@ TEST_F(ScoreTest, PerfectTrackScoresZero) {
   EXPECT_EQ(s.motion.rate(), 1.0);
 }
 
+// Postures are unordered pairs; a gesture performance is identified by the
+// last label the track reports within the truth's run of that gesture.
+TEST_F(ScoreTest, PosturesAndGesturesAgainstTheTruthsLabels) {
+  std::vector<Json> track;
+  int present = 0, gesture_frames = 0, with_pair = 0, wrong = 0;
+  for (const Json& t : truth_) {
+    Json j = Perfect(t);
+    const Json& p = t["labels"]["posture"];
+    // The pair reversed (still right), except every fifth frame (wrong).
+    const bool make_wrong = t["present"].get<bool>() && present++ % 5 == 0;
+    j["posture"] = {{"pair", {p[1], make_wrong ? Json("A9") : p[0]}}};
+    if (t["present"].get<bool>()) ++with_pair, wrong += make_wrong;
+    // The gesture said on its first frames, then another one at its end.
+    if (t["labels"]["gesture"].is_string()) {
+      ++gesture_frames;
+      j["gesture"] = {{"label", gesture_frames < 20 ? "raise_overhead" : "flap_one"}, {"score", 1}, {"start_frame", 0}};
+    }
+    track.push_back(j);
+  }
+  Write(dir_ / "labels.jsonl", track);
+  const Score s = ScoreTrack(dir_ / "seq/truth/frames.jsonl", dir_ / "labels.jsonl");
+  EXPECT_EQ(s.posture.total, with_pair);
+  EXPECT_EQ(s.posture.correct, with_pair - wrong);
+  EXPECT_EQ(s.gesture.total, 1);  // one raise_overhead performance
+  EXPECT_EQ(s.gesture.correct, 0);
+  EXPECT_EQ(s.gesture_confusion.at("raise_overhead").at("flap_one"), 1);
+  EXPECT_NE(s.Markdown().find("**Gestures**"), std::string::npos);
+  EXPECT_EQ(s.ToJson()["postures"]["total"], with_pair);
+}
+
 TEST_F(ScoreTest, ReportsExactlyTheInjectedErrors) {
   std::vector<Json> track;
   std::vector<int> outlier_frames;

@@ -49,7 +49,8 @@ struct Scenario {
 const std::vector<std::string>& KnownMetrics() {
   static const std::vector<std::string> m = [] {
     std::vector<std::string> out = {"silhouette_iou_median", "tracked_fraction", "arms_mean_cm",
-                                    "pointing_mean_deg", "rest_accuracy"};
+                                    "pointing_mean_deg", "rest_accuracy", "posture_accuracy",
+                                    "gesture_identification"};
     for (const std::string& joint : ScoredJoints()) out.push_back(joint + "_mean_cm");
     return out;
   }();
@@ -291,6 +292,15 @@ Measured RunScenario(const Scenario& sc, const std::string& suite, const fs::pat
       ++arm_joints;
     }
   }
+  // Recognition (thesis 5.1, 5.3), when the tracker had the models.
+  if (score.posture.total > 0) {
+    metrics["posture_accuracy"] = score.posture.rate();
+    out.weights["posture_accuracy"] = score.posture.total;
+  }
+  if (score.gesture.total > 0) {
+    metrics["gesture_identification"] = score.gesture.rate();
+    out.weights["gesture_identification"] = score.gesture.total;
+  }
   if (arm_joints) metrics["arms_mean_cm"] = arms / arm_joints;
   // Pointing: the kept samples of both hands together.
   double pointing = 0;
@@ -411,7 +421,7 @@ void WriteSummary(SuiteResult& result, const fs::path& dir) {
 std::string SuiteResult::PooledTable() const {
   std::ostringstream out;
   out << "| motion | person | scenarios | present frames | root | waist | neck | shoulders | elbows | wrists | arms | "
-         "rest | tracked |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "rest | tracked | postures | gestures |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   const auto cm = [](const PooledRow& r, const std::string& m) {
     const auto it = r.metrics.find(m);
     return it == r.metrics.end() ? std::string("–") : Fixed(it->second, 2);
@@ -429,8 +439,8 @@ std::string SuiteResult::PooledTable() const {
     out << "| " << r.group << " | " << r.person << " | " << r.scenarios << " | " << r.frames << " | "
         << cm(r, "root_mean_cm") << " | " << cm(r, "waist_mean_cm") << " | " << cm(r, "neck_mean_cm") << " | "
         << pair(r, "shoulder") << " | " << pair(r, "elbow") << " | " << pair(r, "wrist") << " | "
-        << cm(r, "arms_mean_cm") << " | " << pct(r, "rest_accuracy") << " | " << pct(r, "tracked_fraction")
-        << " |\n";
+        << cm(r, "arms_mean_cm") << " | " << pct(r, "rest_accuracy") << " | " << pct(r, "tracked_fraction") << " | "
+        << pct(r, "posture_accuracy") << " | " << pct(r, "gesture_identification") << " |\n";
   }
   return out.str();
 }

@@ -24,6 +24,10 @@
 //   arms_mean_cm            the mean of the six arm joints' means
 //   pointing_mean_deg       pointing error, both hands' kept samples (Table 6.3)
 //   rest_accuracy           rest-state agreement, both arms (0..1)
+//   posture_accuracy        recognised atom pairs equal to the truth's (0..1;
+//                           when the tracker has posture atoms)
+//   gesture_identification  performances identified (0..1; when the tracker
+//                           has gesture models and the motion has gestures)
 
 #include <filesystem>
 #include <map>

@@ -290,6 +290,8 @@ FrameTracker::Step FrameTracker::Track(int f,
   if (pose_tracker_) step.pose = pose_tracker_->Step(step.features, dt);
   const auto shape_start = std::chrono::steady_clock::now();
   step.shape = Shape(step.features, step.pose, shape_options_);
+  const auto shape_end = std::chrono::steady_clock::now();
+  const double shape_ms = std::chrono::duration<double, std::milli>(shape_end - shape_start).count();
   if (step.shape && posture_atoms_) {
     const bool at_rest = step.pose && step.pose->tracking && step.pose->rest[0].value_or(false) &&
                          step.pose->rest[1].value_or(false);
@@ -307,8 +309,8 @@ FrameTracker::Step FrameTracker::Track(int f,
     const bool at_rest = step.pose && step.pose->rest[0].value_or(false) && step.pose->rest[1].value_or(false);
     step.gesture = gesture_recognizer_->Update(f, observation, at_rest);
   }
-  const double shape_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shape_start).count();
+  const double recognition_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shape_end).count();
   nlohmann::json& line = step.features_line;
   line["frame"] = f;
   line["t"] = f / input_.fps();
@@ -320,6 +322,7 @@ FrameTracker::Step FrameTracker::Track(int f,
   step.track_line = TrackLine(f, f / input_.fps(), step.features, step.pose, input_.cameras(), line);
   line["ms"] = StageMs(step.features, step.pose);
   line["ms"]["shape"] = shape_ms;
+  line["ms"]["postures_gestures"] = recognition_ms;
   step.track_line["posture"] = PostureJson(step.posture, posture_atoms_.get());
   if (step.gesture) {
     step.track_line["gesture"] = {{"label", gesture_models_->gestures[step.gesture->gesture]},
