@@ -430,8 +430,28 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
                        dir)
                 .exit_code,
             0);
+  // Bad recognition models: another format, atoms made for another
+  // descriptor size, gesture models without gestures.
+  WriteText(dir / "atoms_v9.json", R"({"format": "irbench.posture-atoms/9"})");
+  std::string atoms = ReadText(fs::path(IRBENCH_SOURCE_DIR) / "tracker/models/posture_atoms.json");
+  ASSERT_NE(atoms.find("\"phi_bins\":24"), std::string::npos);
+  atoms.replace(atoms.find("\"phi_bins\":24"), std::string("\"phi_bins\":24").size(), "\"phi_bins\":12");
+  WriteText(dir / "atoms_12.json", atoms);
+  WriteText(dir / "gestures_none.json",
+            R"({"format": "irbench.gesture-models/1", "gestures": [], "atoms": ["A0", "A1"], "models": []})");
   for (const auto& [args, expected] :
        {std::pair<std::vector<std::string>, std::string>{{"track", (dir / "seq").string()}, "exists"},
+        {{"track", (dir / "seq").string(), "--posture-atoms", (dir / "atoms_v9.json").string(), "--out",
+          (dir / "t10").string()},
+         "atoms_v9.json: format: must be irbench.posture-atoms/1"},
+        {{"track", (dir / "seq").string(), "--posture-atoms", (dir / "atoms_12.json").string(), "--out",
+          (dir / "t10").string()},
+         "atoms_12.json: rest.bins: has 13824 bins; the descriptor has 6912"},
+        {{"track", (dir / "seq").string(), "--gesture-models", (dir / "gestures_none.json").string(), "--out",
+          (dir / "t10").string()},
+         "gestures_none.json: gestures: needs at least one gesture"},
+        {{"track", (dir / "seq").string(), "--gesture-model", "crf", "--out", (dir / "t10").string()},
+         "--gesture-model"},
         {{"track", (dir / "seq").string(), "--stage", "skeleton", "--out", (dir / "t2").string()}, "--stage"},
         {{"track", (dir / "seq").string(), "--particles", "0", "--out", (dir / "t4").string()}, "--particles"},
         {{"track", (dir / "seq").string(), "--rest-model", (dir / "nosuch.yml").string(), "--out",
@@ -455,7 +475,7 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
     EXPECT_NE(bad.err.find(expected), std::string::npos) << bad.err;
   }
-  for (const char* name : {"t2", "t3", "t4", "t5", "t6", "t7", "t8", "t9"}) EXPECT_FALSE(fs::exists(dir / name));
+  for (const char* name : {"t2", "t3", "t4", "t5", "t6", "t7", "t8", "t9", "t10"}) EXPECT_FALSE(fs::exists(dir / name));
   EXPECT_FALSE(fs::exists(dir / "nobg" / "track"));
   // An output that would replace the sequence or land in what it reads
   // (common/atomic_file.h), or a folder irbench did not write.
