@@ -33,6 +33,7 @@ struct Heard {
   std::map<int, std::map<std::string, std::array<double, 3>>> joints;
   std::map<int, std::map<std::string, int>> rest;
   std::map<int, int> dropped;
+  std::map<int, std::string> posture;
 };
 
 int OnMessage(const char* path, const char* types, lo_arg** argv, int argc, lo_message, void* user) {
@@ -46,6 +47,8 @@ int OnMessage(const char* path, const char* types, lo_arg** argv, int argc, lo_m
     heard.joints[heard.frames.back()][&argv[0]->s] = {argv[1]->d, argv[2]->d, argv[3]->d};
   } else if (p == "/irbench/rest" && argc == 2 && !heard.frames.empty()) {
     heard.rest[heard.frames.back()][&argv[0]->s] = argv[1]->i;
+  } else if (p == "/irbench/posture" && std::string(types) == "s" && !heard.frames.empty()) {
+    heard.posture[heard.frames.back()] = &argv[0]->s;
   }
   return 0;
 }
@@ -124,7 +127,7 @@ TEST_F(LiveTest, EveryTrackedFrameSetIsOneBundleWithTheRecordedJoints) {
   Heard& heard = receiver.heard();
   std::lock_guard lock(heard.mutex);
   ASSERT_EQ(heard.frames.size(), record.size());
-  int joints_compared = 0;
+  int joints_compared = 0, postures_compared = 0;
   for (size_t i = 0; i < record.size(); ++i) {
     const int f = record[i]["frame"];
     EXPECT_EQ(heard.frames[i], f);
@@ -140,8 +143,14 @@ TEST_F(LiveTest, EveryTrackedFrameSetIsOneBundleWithTheRecordedJoints) {
     if (record[i]["rest"].is_object()) {
       EXPECT_EQ(heard.rest[f]["right"], record[i]["rest"]["right"].get<bool>() ? 1 : 0) << f;
     }
+    if (record[i]["posture"].is_object()) {
+      const auto& pair = record[i]["posture"]["pair"];
+      EXPECT_EQ(heard.posture[f], pair[0].get<std::string>() + "+" + pair[1].get<std::string>()) << f;
+      ++postures_compared;
+    }
   }
   EXPECT_GT(joints_compared, 10 * static_cast<int>(record.size()));
+  EXPECT_GT(postures_compared, static_cast<int>(record.size()) / 2);  // the shipped posture atoms
   // What was tracked tracks the person: the recorded track against the truth.
   const irbench::testing::TrackFigures figures = irbench::testing::UpperBodyFigures(record, truth);
   EXPECT_GT(figures.Fraction(), 0.8);

@@ -95,12 +95,26 @@ bool OscPublisher::Publish(const nlohmann::json& line, int dropped) {
     lo_message_add_double(m, line["height_m"].get<double>());
     add("/irbench/height", m);
   }
-  for (const auto& [key, path] : {std::pair{"posture", "/irbench/posture"}, std::pair{"gesture", "/irbench/gesture"},
-                                   std::pair{"motion", "/irbench/motion"}}) {
-    if (!line[key].is_string()) continue;
+  // Postures and gestures (docs/recognition.md): the pair as "A0+A2"; the
+  // gesture's label, score and start frame.
+  const nlohmann::json& posture = line["posture"];
+  if (posture.is_object() && posture["pair"].is_array() && posture["pair"].size() == 2) {
     lo_message m = lo_message_new();
-    lo_message_add_string(m, line[key].get<std::string>().c_str());
-    add(path, m);
+    lo_message_add_string(m, (posture["pair"][0].get<std::string>() + "+" + posture["pair"][1].get<std::string>()).c_str());
+    add("/irbench/posture", m);
+  }
+  const nlohmann::json& gesture = line["gesture"];
+  if (gesture.is_object() && gesture["label"].is_string()) {
+    lo_message m = lo_message_new();
+    lo_message_add_string(m, gesture["label"].get<std::string>().c_str());
+    lo_message_add_double(m, gesture.value("score", 0.0));
+    lo_message_add_int32(m, gesture.value("start_frame", 0));
+    add("/irbench/gesture", m);
+  }
+  if (line["motion"].is_string()) {
+    lo_message m = lo_message_new();
+    lo_message_add_string(m, line["motion"].get<std::string>().c_str());
+    add("/irbench/motion", m);
   }
   const int sent = lo_send_bundle(address_->address, bundle);
   lo_bundle_free_recursive(bundle);
