@@ -172,7 +172,6 @@ TrainingTrace TrainFhmm(const std::vector<Eigen::MatrixXd>& sequences, const Bau
   Eigen::MatrixXd yy = Eigen::MatrixXd::Zero(d, d);
   for (const auto& s : sequences) yy += s * s.transpose();
 
-  TrainingTrace trace;
   std::vector<Posteriors> post;
   auto e_step = [&]() {
     post.clear();
@@ -184,9 +183,8 @@ TrainingTrace TrainFhmm(const std::vector<Eigen::MatrixXd>& sequences, const Bau
     }
     return total;
   };
-  double ll = e_step();
-  for (int it = 0; it < options.max_iterations; ++it) {
-    trace.log_likelihood.push_back(ll);
+  const double ll = e_step();
+  return RunBaumWelch(ll, frames, options, [&] {
     Eigen::MatrixXd ys = Eigen::MatrixXd::Zero(d, mk);   // sum y_t E[S_t]'
     Eigen::MatrixXd ss = Eigen::MatrixXd::Zero(mk, mk);  // sum E[S_t S_t']
     std::vector<ChainCounts> counts(chains, ChainCounts(k));
@@ -218,17 +216,8 @@ TrainingTrace TrainFhmm(const std::vector<Eigen::MatrixXd>& sequences, const Bau
     sigma = 0.5 * (sigma + sigma.transpose()).eval();
     sigma.diagonal().array() += covariance.ridge;
     model->covariance = sigma;
-    const double next = e_step();
-    ++trace.iterations;
-    const bool done = next - ll < options.tolerance_per_frame * frames;
-    ll = next;
-    if (done) {
-      trace.converged = true;
-      break;
-    }
-  }
-  trace.final_log_likelihood = ll;
-  return trace;
+    return e_step();
+  });
 }
 
 }  // namespace irbench

@@ -160,6 +160,25 @@ void BaumWelchOptions::Check() const {
   if (!(pseudo_count >= 0) || !std::isfinite(pseudo_count)) throw std::invalid_argument("pseudo_count must be >= 0");
 }
 
+TrainingTrace RunBaumWelch(double log_likelihood, size_t frames, const BaumWelchOptions& options,
+                           const std::function<double()>& iterate) {
+  TrainingTrace trace;
+  double ll = log_likelihood;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    trace.log_likelihood.push_back(ll);
+    const double next = iterate();
+    ++trace.iterations;
+    const bool done = next - ll < options.tolerance_per_frame * frames;
+    ll = next;
+    if (done) {
+      trace.converged = true;
+      break;
+    }
+  }
+  trace.final_log_likelihood = ll;
+  return trace;
+}
+
 void ChainCounts::Add(const Posteriors& p) {
   initial += p.gamma.row(0).transpose();
   transition += p.xi_sum;
@@ -208,12 +227,10 @@ TrainingTrace TrainDiscreteHmm(const std::vector<std::vector<int>>& sequences, c
   }
   if (frames == 0) throw std::invalid_argument("no training sequences");
   const int n = hmm->chain.size(), m = hmm->symbols();
-  TrainingTrace trace;
   std::vector<Posteriors> post;
   auto emit = [&](size_t s) { return hmm->EmissionLogLikelihoods(sequences[s]); };
-  double ll = EStep(hmm->chain, sequences.size(), emit, &post);
-  for (int it = 0; it < options.max_iterations; ++it) {
-    trace.log_likelihood.push_back(ll);
+  const double ll = EStep(hmm->chain, sequences.size(), emit, &post);
+  return RunBaumWelch(ll, frames, options, [&] {
     ChainCounts counts(n);
     Eigen::MatrixXd emission = Eigen::MatrixXd::Constant(n, m, options.pseudo_count);
     for (size_t s = 0; s < sequences.size(); ++s) {
@@ -227,17 +244,8 @@ TrainingTrace TrainDiscreteHmm(const std::vector<std::vector<int>>& sequences, c
         hmm->log_emission.row(j) = (emission.row(j) / total).unaryExpr([](double p) { return SafeLog(p); });
       }
     }
-    const double next = EStep(hmm->chain, sequences.size(), emit, &post);
-    ++trace.iterations;
-    const bool done = next - ll < options.tolerance_per_frame * frames;
-    ll = next;
-    if (done) {
-      trace.converged = true;
-      break;
-    }
-  }
-  trace.final_log_likelihood = ll;
-  return trace;
+    return EStep(hmm->chain, sequences.size(), emit, &post);
+  });
 }
 
 Eigen::MatrixXd GaussianLogDensities(const Eigen::MatrixXd& y, const Eigen::MatrixXd& means,
@@ -279,12 +287,10 @@ TrainingTrace TrainGaussianHmm(const std::vector<Eigen::MatrixXd>& sequences, co
     frames += s.cols();
   }
   if (frames == 0) throw std::invalid_argument("no training sequences");
-  TrainingTrace trace;
   std::vector<Posteriors> post;
   auto emit = [&](size_t s) { return hmm->EmissionLogLikelihoods(sequences[s]); };
-  double ll = EStep(hmm->chain, sequences.size(), emit, &post);
-  for (int it = 0; it < options.max_iterations; ++it) {
-    trace.log_likelihood.push_back(ll);
+  const double ll = EStep(hmm->chain, sequences.size(), emit, &post);
+  return RunBaumWelch(ll, frames, options, [&] {
     ChainCounts counts(n);
     Eigen::VectorXd weight = Eigen::VectorXd::Zero(n);
     Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(d, n);
@@ -307,17 +313,8 @@ TrainingTrace TrainGaussianHmm(const std::vector<Eigen::MatrixXd>& sequences, co
     hmm->covariance = scatter / static_cast<double>(frames);
     hmm->covariance = 0.5 * (hmm->covariance + hmm->covariance.transpose()).eval();
     hmm->covariance.diagonal().array() += covariance.ridge;
-    const double next = EStep(hmm->chain, sequences.size(), emit, &post);
-    ++trace.iterations;
-    const bool done = next - ll < options.tolerance_per_frame * frames;
-    ll = next;
-    if (done) {
-      trace.converged = true;
-      break;
-    }
-  }
-  trace.final_log_likelihood = ll;
-  return trace;
+    return EStep(hmm->chain, sequences.size(), emit, &post);
+  });
 }
 
 }  // namespace irbench

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace irbench {
@@ -77,6 +78,14 @@ struct TrainingTrace {
   int iterations = 0;
   bool converged = false;
 };
+
+// The EM loop the models share: `iterate` re-estimates the model from the
+// current posteriors, runs the next E-step and returns its log-likelihood.
+// Starts from `log_likelihood` (the first E-step's); stops after
+// max_iterations or when the gain per frame (of `frames`) falls below
+// tolerance_per_frame.
+TrainingTrace RunBaumWelch(double log_likelihood, size_t frames, const BaumWelchOptions& options,
+                           const std::function<double()>& iterate);
 
 // The expected counts of one chain over a set of sequences, summed.
 struct ChainCounts {
