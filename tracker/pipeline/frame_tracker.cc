@@ -306,7 +306,11 @@ FrameTracker::Step FrameTracker::Track(int f,
       observation->primary = step.posture->pair[1];
       observation->secondary = step.posture->pair[0];
     }
-    const bool at_rest = step.pose && step.pose->rest[0].value_or(false) && step.pose->rest[1].value_or(false);
+    // Both arms at rest by the rest-state classifier; where it has no
+    // answer (the pose not tracked), by the recognised posture.
+    const bool classified = step.pose && step.pose->rest[0] && step.pose->rest[1];
+    const bool at_rest = classified ? *step.pose->rest[0] && *step.pose->rest[1]
+                                    : step.posture && step.posture->pair == std::array<int, 2>{0, 0};
     step.gesture = gesture_recognizer_->Update(f, observation, at_rest);
   }
   const double recognition_ms =
