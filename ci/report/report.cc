@@ -64,6 +64,83 @@ std::string StatsRow(const std::string& name, const ErrorStats& s) {
          std::to_string(s.missing) + "</td><td>" + cell(s.max) + "</td></tr>\n";
 }
 
+// A confusion matrix (truth -> found -> count) as an HTML table, rows truth.
+std::string ConfusionTable(const std::string& id, const std::string& title_html,
+                           const std::map<std::string, std::map<std::string, int>>& confusion) {
+  std::vector<std::string> labels;
+  for (const auto& [t, row] : confusion) {
+    labels.push_back(t);
+    for (const auto& [l, n] : row) labels.push_back(l);
+  }
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  std::ostringstream out;
+  out << "<h3>" << title_html << "</h3>\n<table id=\"" << id << "\"><tr><th></th>";
+  for (const std::string& l : labels) out << "<th>" << Escape(l) << "</th>";
+  out << "</tr>\n";
+  for (const std::string& t : labels) {
+    const auto row = confusion.find(t);
+    if (row == confusion.end()) continue;
+    out << "<tr><th>" << Escape(t) << "</th>";
+    for (const std::string& l : labels) {
+      const auto c = row->second.find(l);
+      out << "<td>" << (c == row->second.end() ? 0 : c->second) << "</td>";
+    }
+    out << "</tr>\n";
+  }
+  out << "</table>\n";
+  return out.str();
+}
+
+// The gestures over time (truth above, recognised below) as an inline SVG:
+// one colour per gesture, blank where there is none. Empty when neither
+// side names a gesture.
+std::string GestureTimeline(const Score& score) {
+  const auto& rows = score.gesture_timeline;
+  std::vector<std::string> names;
+  for (const auto& [frame, truth, found] : rows) {
+    for (const std::string* n : {&truth, &found}) {
+      if (!n->empty() && std::find(names.begin(), names.end(), *n) == names.end()) names.push_back(*n);
+    }
+  }
+  if (names.empty() || rows.empty()) return "";
+  std::sort(names.begin(), names.end());
+  static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                                   "#7f7f7f", "#bcbd22", "#17becf"};
+  const int first = std::get<0>(rows.front()), last = std::get<0>(rows.back());
+  const double width = 900, scale = width / std::max(1, last - first + 1);
+  std::ostringstream svg;
+  svg << "<h3>Gestures over time <small>(frames " << first << "–" << last
+      << "; top: truth, bottom: recognised)</small></h3>\n<svg id=\"gesture-timeline\" width=\"" << width + 90
+      << "\" height=\"70\" xmlns=\"http://www.w3.org/2000/svg\" font-size=\"11\">"
+      << "<text x=\"0\" y=\"16\">truth</text><text x=\"0\" y=\"44\">recognised</text>";
+  for (int lane = 0; lane < 2; ++lane) {
+    size_t i = 0;
+    while (i < rows.size()) {
+      const std::string& label = lane == 0 ? std::get<1>(rows[i]) : std::get<2>(rows[i]);
+      size_t j = i;
+      while (j + 1 < rows.size() && (lane == 0 ? std::get<1>(rows[j + 1]) : std::get<2>(rows[j + 1])) == label &&
+             std::get<0>(rows[j + 1]) == std::get<0>(rows[j]) + 1) {
+        ++j;
+      }
+      if (!label.empty()) {
+        const size_t c = std::find(names.begin(), names.end(), label) - names.begin();
+        svg << "<rect x=\"" << 80 + (std::get<0>(rows[i]) - first) * scale << "\" y=\"" << 4 + lane * 28
+            << "\" width=\"" << std::max(1.0, (std::get<0>(rows[j]) - std::get<0>(rows[i]) + 1) * scale)
+            << "\" height=\"18\" fill=\"" << kColours[c % 10] << "\"><title>" << Escape(label) << ", frames "
+            << std::get<0>(rows[i]) << "–" << std::get<0>(rows[j]) << "</title></rect>";
+      }
+      i = j + 1;
+    }
+  }
+  svg << "</svg>\n<p class=\"legend\">";
+  for (size_t c = 0; c < names.size(); ++c) {
+    svg << "<span style=\"color:" << kColours[c % 10] << "\">■ " << Escape(names[c]) << "</span> ";
+  }
+  svg << "</p>\n";
+  return svg.str();
+}
+
 std::string Tables(const Score& score) {
   std::ostringstream out;
   out << "<p>Frames: " << score.truth_frames << " in the truth, " << score.present_frames
@@ -86,28 +163,25 @@ std::string Tables(const Score& score) {
   }
   out << "</table>\n";
   if (!score.motion_confusion.empty()) {
-    std::vector<std::string> labels;
-    for (const auto& [t, row] : score.motion_confusion) {
-      labels.push_back(t);
-      for (const auto& [l, n] : row) labels.push_back(l);
-    }
-    std::sort(labels.begin(), labels.end());
-    labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
-    out << "<h3>Motion labels <small>(thesis Tables 7.1–7.2; rows truth, columns tracked; accuracy "
-        << Fixed(100 * score.motion.rate(), 2) << " %)</small></h3>\n<table id=\"motion\"><tr><th></th>";
-    for (const std::string& l : labels) out << "<th>" << Escape(l) << "</th>";
-    out << "</tr>\n";
-    for (const std::string& t : labels) {
-      const auto row = score.motion_confusion.find(t);
-      if (row == score.motion_confusion.end()) continue;
-      out << "<tr><th>" << Escape(t) << "</th>";
-      for (const std::string& l : labels) {
-        const auto c = row->second.find(l);
-        out << "<td>" << (c == row->second.end() ? 0 : c->second) << "</td>";
-      }
-      out << "</tr>\n";
-    }
-    out << "</table>\n";
+    out << ConfusionTable("motion",
+                          "Motion labels <small>(thesis Tables 7.1–7.2; rows truth, columns tracked; accuracy " +
+                              Fixed(100 * score.motion.rate(), 2) + " %)</small>",
+                          score.motion_confusion);
+  }
+  if (!score.posture_confusion.empty()) {
+    out << ConfusionTable("postures",
+                          "Postures <small>(thesis 5.1: atom pairs, unordered; rows truth, columns recognised; " +
+                              Fixed(100 * score.posture.rate(), 2) + " % of " + std::to_string(score.posture.total) +
+                              " frames)</small>",
+                          score.posture_confusion);
+  }
+  if (!score.gesture_confusion.empty()) {
+    out << ConfusionTable("gestures",
+                          "Gestures <small>(thesis 5.3: each performance identified as the last gesture the track "
+                          "reports in it; rows truth, columns identified; " +
+                              Fixed(100 * score.gesture.rate(), 2) + " % of " + std::to_string(score.gesture.total) +
+                              " performances)</small>",
+                          score.gesture_confusion);
   }
   if (score.silhouettes) {
     const SilhouetteScore& sil = *score.silhouettes;
@@ -524,7 +598,7 @@ ReportResult WriteReport(const Score& score, const ReportOptions& options, const
        << "<p class=\"meta\"><span><b>sequence</b> " << Escape(fs::absolute(options.sequence).lexically_normal().string())
        << "</span> <span><b>track</b> " << Escape(fs::absolute(options.track).lexically_normal().string())
        << "</span></p>\n<h2>Tables</h2>\n"
-       << Tables(score) << "<h2>Plots</h2>\n";
+       << Tables(score) << GestureTimeline(score) << "<h2>Plots</h2>\n";
   if (result.plots) {
     for (const auto& [name, title] : std::vector<std::pair<std::string, std::string>>{
              {"joint_histograms", "Joint error histograms (Fig. 6.8)"},

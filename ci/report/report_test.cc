@@ -47,6 +47,10 @@ class ReportTest : public ::testing::Test {
       Json j = {{"frame", t["frame"]}, {"state", t["present"].get<bool>() ? "tracking" : "empty"},
                 {"joints3d", t["joints3d"]}, {"rest", t["labels"]["rest"]}};
       j["joints3d"]["right_elbow"][0] = t["joints3d"]["right_elbow"][0].get<double>() + 0.03;
+      // Postures as the truth's; a gesture the truth does not have, frames 5-15.
+      j["posture"] = {{"pair", t["labels"]["posture"]}};
+      const int f = t["frame"];
+      if (f >= 5 && f <= 15) j["gesture"] = {{"label", "flap_both"}, {"score", 1.0}, {"start_frame", 5}};
       if (t["present"].get<bool>()) {
         const BodyShape shape = BodyShape::FromHeight(1.75);
         const BodyPose pose =
@@ -175,6 +179,11 @@ TEST_F(ReportTest, WithoutGnuplotThePageSaysSo) {
   EXPECT_EQ(html.find("data:image/svg+xml"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir_ / "score_no_gnuplot/plots"));
   EXPECT_NE(html.find("<table id=\"joints\">"), std::string::npos);
+  // Recognition: the postures' table, and the gesture timeline (inline SVG,
+  // no gnuplot) with the recognised gesture where the track put it.
+  EXPECT_NE(html.find("<table id=\"postures\">"), std::string::npos);
+  EXPECT_NE(html.find("<svg id=\"gesture-timeline\""), std::string::npos);
+  EXPECT_NE(html.find("<title>flap_both, frames 5–15</title>"), std::string::npos);
 }
 
 // Debian's Chromium, headless, as root: what the page printed to its console

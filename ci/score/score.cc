@@ -162,7 +162,7 @@ struct GestureRuns {
   Score* score;
   std::string gesture, label;  // the current run's truth and latest tracked label
 
-  void Add(const Json* truth_labels, const Json* track) {
+  void Add(int frame, const Json* truth_labels, const Json* track) {
     const Json* truth_gesture = truth_labels ? Child(*truth_labels, "gesture") : nullptr;
     const std::string truth = truth_gesture && truth_gesture->is_string() ? truth_gesture->get<std::string>() : "";
     if (truth != gesture) {
@@ -172,6 +172,7 @@ struct GestureRuns {
     const Json* track_gesture = track ? Child(*track, "gesture") : nullptr;
     const Json* found = track_gesture && track_gesture->is_object() ? Child(*track_gesture, "label") : nullptr;
     if (!gesture.empty() && found && found->is_string()) label = found->get<std::string>();
+    score->gesture_timeline.emplace_back(frame, truth, found && found->is_string() ? found->get<std::string>() : "");
   }
   void Close() {
     if (!gesture.empty()) {
@@ -276,7 +277,7 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       ++score.motion.total;
       score.motion.correct += label == truth_label;
     }
-    gestures.Add(truth_labels, track);
+    gestures.Add(frame, truth_labels, track);
     ScorePosture(truth_labels, track, &score);
   }
   gestures.Close();

@@ -83,6 +83,9 @@ struct Score {
   // Truth gesture -> identified as -> count.
   std::map<std::string, std::map<std::string, int>> gesture_confusion;
   Accuracy gesture;
+  // Per present frame: the truth's gesture and the track's ("" for none),
+  // for the report's timeline.
+  std::vector<std::tuple<int, std::string, std::string>> gesture_timeline;
   // The tracker's silhouettes against the truth masks, when the track folder
   // has them (irbench track writes silhouettes/ beside track.jsonl).
   std::optional<SilhouetteScore> silhouettes;
