@@ -210,7 +210,7 @@ BrowserRun OpenInChromium(const fs::path& chromium, const fs::path& page, const 
       "timeout 120 '" + chromium.string() +
       "' --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking"
       " --disable-component-update --disable-sync --user-data-dir='" + (work / "profile").string() +
-      "' --enable-logging=stderr --v=0 --virtual-time-budget=5000 --window-size=1400,3600 --screenshot='" +
+      "' --enable-logging=stderr --v=0 --virtual-time-budget=5000 --window-size=1400,5000 --screenshot='" +
       run.screenshot.string() + "' 'file://" + fs::absolute(page).string() + "' > '" + log.string() + "' 2>&1";
   run.status = std::system(command.c_str());
   std::istringstream lines(ReadText(log));
