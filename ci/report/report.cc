@@ -67,13 +67,7 @@ std::string StatsRow(const std::string& name, const ErrorStats& s) {
 // A confusion matrix (truth -> found -> count) as an HTML table, rows truth.
 std::string ConfusionTable(const std::string& id, const std::string& title_html,
                            const std::map<std::string, std::map<std::string, int>>& confusion) {
-  std::vector<std::string> labels;
-  for (const auto& [t, row] : confusion) {
-    labels.push_back(t);
-    for (const auto& [l, n] : row) labels.push_back(l);
-  }
-  std::sort(labels.begin(), labels.end());
-  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  const std::vector<std::string> labels = ConfusionLabels(confusion);
   std::ostringstream out;
   out << "<h3>" << title_html << "</h3>\n<table id=\"" << id << "\"><tr><th></th>";
   for (const std::string& l : labels) out << "<th>" << Escape(l) << "</th>";

@@ -55,6 +55,21 @@ std::string TrackState(const Json& line, const fs::path& file) {
   return s;
 }
 
+}  // namespace
+
+std::vector<std::string> ConfusionLabels(const std::map<std::string, std::map<std::string, int>>& confusion) {
+  std::vector<std::string> labels;
+  for (const auto& [t, row] : confusion) {
+    labels.push_back(t);
+    for (const auto& [l, n] : row) labels.push_back(l);
+  }
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  return labels;
+}
+
+namespace {
+
 // "A1+A3": an unordered pair of atom names, in order.
 std::string PairKey(const std::string& a, const std::string& b) { return a < b ? a + "+" + b : b + "+" + a; }
 
@@ -304,13 +319,7 @@ namespace {
 // A confusion matrix (truth -> found -> count) as a Markdown table, rows
 // truth, columns found, over the labels either side uses.
 std::string ConfusionMarkdown(const std::map<std::string, std::map<std::string, int>>& confusion) {
-  std::vector<std::string> labels;
-  for (const auto& [t, row] : confusion) {
-    labels.push_back(t);
-    for (const auto& [l, n] : row) labels.push_back(l);
-  }
-  std::sort(labels.begin(), labels.end());
-  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  const std::vector<std::string> labels = ConfusionLabels(confusion);
   std::ostringstream out;
   out << "| |";
   for (const std::string& l : labels) out << " " << l << " |";

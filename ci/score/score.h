@@ -51,6 +51,10 @@ std::string TitleCase(const std::string& name);
 // `v` with `digits` decimals ("%.*f"), for the tables.
 std::string Fixed(double v, int digits);
 
+// The labels a confusion matrix (truth -> found -> count) uses on either
+// side, sorted: its tables' rows and columns.
+std::vector<std::string> ConfusionLabels(const std::map<std::string, std::map<std::string, int>>& confusion);
+
 // The nine joints of Table 6.1, in its order.
 const std::vector<std::string>& ScoredJoints();
 
