@@ -13,6 +13,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev libtinygltf-dev
+  liblbfgs-dev  # L-BFGS for the motion-label CRFs (tracker/motion_labels)
   libssl-dev    # SHA-256 of the model files a track used (common/sha256.h)
   gnuplot-nox   # the report's plots (irbench score)
   chromium      # the report's test opens it in headless Chromium

@@ -1,5 +1,7 @@
 // `irbench train rest`: train the tracker's rest-state SVM from simulated truth.
 // `irbench train atoms`: learn the posture atoms from rendered sequences.
+// `irbench train gestures`: the gesture HMMs; `irbench train motion-labels`:
+// the motion-label CRF and LDCRF.
 
 #include <iostream>
 #include <memory>
@@ -7,6 +9,7 @@
 
 #include "ci/train/atom_training.h"
 #include "ci/train/gesture_training.h"
+#include "ci/train/motion_label_training.h"
 #include "ci/train/rest_training.h"
 #include "cli/commands.h"
 #include "cli/option_checks.h"
@@ -84,6 +87,79 @@ int RunTrainGestures(const CLI::App& cmd, TrainGesturesArgs& args) {
 
 }  // namespace
 
+// What `irbench train motion-labels`' flags bind to.
+struct TrainMotionArgs {
+  MotionLabelTrainingJob job;
+  std::vector<std::string> train, test, models = {"crf", "ldcrf"};
+  std::string out, table, rest, decision = "balanced";
+};
+
+// Trains the models; prints the training summary, the tables with test
+// sequences, and the model files.
+int RunTrainMotionLabels(const CLI::App& cmd, TrainMotionArgs& args) {
+  RequireNotEmpty(cmd, "--out", args.out);
+  MotionLabelTrainingJob& job = args.job;
+  for (const std::string& s : args.train) job.train.emplace_back(s);
+  for (const std::string& s : args.test) job.test.emplace_back(s);
+  job.kinds.clear();
+  for (const std::string& m : args.models) job.kinds.push_back(m == "crf" ? MotionModelKind::kCrf : MotionModelKind::kLdcrf);
+  job.out_dir = args.out;
+  job.table = args.table;
+  job.rest_model = args.rest;
+  job.decision = args.decision == "balanced" ? MotionDecision::kBalanced : MotionDecision::kMaxMarginal;
+  const MotionLabelTrainingResult r = RunMotionLabelTraining(job);
+  std::cout << "motion labels: " << r.train_frames << " training arm-frames\n";
+  for (const auto& [kind, report] : r.reports) {
+    std::cout << kind << ": " << report.status_text << " after " << report.iterations << " L-BFGS iterations in "
+              << r.train_seconds.at(kind) << " s\n";
+  }
+  if (!r.evaluation.confusion.empty()) {
+    std::cout << r.evaluation.frames << " test arm-frames\n" << r.evaluation.Markdown();
+  }
+  for (const auto& path : r.models) std::cout << path.string() << "\n";
+  return kExitOk;
+}
+
+Command AddTrainMotionLabels(CLI::App* train_cmd) {
+  auto args = std::make_shared<TrainMotionArgs>();
+  CLI::App* cmd = train_cmd->add_subcommand(
+      "motion-labels",
+      "Motion labels (thesis 7.1): CRF and LDCRF over the tracked arms' features, from rendered\n"
+      "sequences with motion labels (story-telling, gesture sessions) as the tracker tracked them\n"
+      "(SEQ/track when it holds a pose-stage track, else tracked here); with --test, Tables 7.1-7.2");
+  cmd->add_option("--train", args->train, "rendered sequences to train on")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("--test", args->test, "rendered sequences to score the models on")->check(CLI::ExistingDirectory);
+  cmd->add_option("--models", args->models, "which models to train")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"crf", "ldcrf"}));
+  cmd->add_option("--window", args->job.window, "frames before and after in each frame's features")
+      ->capture_default_str()
+      ->transform(IntegerIn(0, 100));
+  cmd->add_option("--ldcrf-states", args->job.ldcrf_states, "hidden states per label of the LDCRF")
+      ->capture_default_str()
+      ->transform(IntegerIn(1, 16));
+  cmd->add_option("--sigma", args->job.options.sigma,
+                  "regularisation: the Gaussian prior's sigma, |theta|^2 / (2 sigma^2); 0 for none")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--iterations", args->job.options.max_iterations, "L-BFGS iterations at most")
+      ->capture_default_str()
+      ->transform(IntegerIn(1, 100000));
+  cmd->add_option("--seed", args->job.options.seed, "seed of the LDCRF's starting weights")
+      ->capture_default_str()
+      ->transform(Uint64Text());
+  cmd->add_option("--decision", args->decision,
+                  "a frame's label: balanced (largest p(label | x) / training share: the rule for the mean\n"
+                  "per-label recall) or max_marginal (largest p(label | x))")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"balanced", "max_marginal"}));
+  cmd->add_flag("--retrack", args->job.retrack, "track every sequence here even when it has a track/");
+  cmd->add_option("--rest-model", args->rest, "rest-state SVM for the margin feature (default: the shipped one)");
+  cmd->add_option("--table", args->table, "also write the tables as Markdown to this file");
+  cmd->add_option("--out", args->out, "folder of the model files (default: tracker/models)");
+  return {cmd, [cmd, args] { return RunTrainMotionLabels(*cmd, *args); }};
+}
+
 std::vector<Command> AddTrainCommand(CLI::App& app) {
   CLI::App* train_cmd =
       app.add_subcommand("train", "Train the tracker's learned parts from simulated truth");
@@ -150,7 +226,8 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   gestures_cmd->add_option("--out", gesture_args->out, "model file (default: tracker/models/gesture_models.json)");
   return {{cmd, [cmd, args] { return RunTrainRest(*cmd, *args); }},
           {gestures_cmd, [gestures_cmd, gesture_args] { return RunTrainGestures(*gestures_cmd, *gesture_args); }},
-          {atoms_cmd, [atoms_cmd, atom_args] { return RunTrainAtoms(*atoms_cmd, *atom_args); }}};
+          {atoms_cmd, [atoms_cmd, atom_args] { return RunTrainAtoms(*atoms_cmd, *atom_args); }},
+          AddTrainMotionLabels(train_cmd)};
 }
 
 }  // namespace irbench::cli

@@ -86,11 +86,31 @@ std::string ConfusionTable(const std::string& id, const std::string& title_html,
   return out.str();
 }
 
-// The gestures over time (truth above, recognised below) as an inline SVG:
-// one colour per gesture, blank where there is none. Empty when neither
-// side names a gesture.
-std::string GestureTimeline(const Score& score) {
-  const auto& rows = score.gesture_timeline;
+// Per truth label: frames, our recall, and the diagonals of the thesis's
+// Tables 7.1 (CRF) and 7.2 (LDCRF).
+std::string MotionRecallTable(const std::map<std::string, std::map<std::string, int>>& confusion) {
+  const std::map<std::string, double> recall = PerLabelRecall(confusion);
+  std::ostringstream out;
+  out << "<table id=\"motion-recall\"><tr><th>label</th><th>frames</th><th>recall</th><th>thesis CRF</th>"
+      << "<th>thesis LDCRF</th></tr>\n";
+  auto percent = [](double v) { return std::isnan(v) ? std::string("–") : Fixed(100 * v, 1) + " %"; };
+  for (const auto& [label, r] : recall) {
+    int frames = 0;
+    for (const auto& [found, n] : confusion.at(label)) frames += n;
+    out << "<tr><th>" << Escape(label) << "</th><td>" << frames << "</td><td>" << percent(r) << "</td><td>"
+        << percent(ThesisMotionRecall("crf", label)) << "</td><td>" << percent(ThesisMotionRecall("ldcrf", label))
+        << "</td></tr>\n";
+  }
+  out << "<tr><th>mean</th><td></td><td>" << percent(MeanRecall(confusion)) << "</td><td>74.3 %</td><td>85.5 %</td></tr>\n"
+      << "</table>\n";
+  return out.str();
+}
+
+// Labels over time (truth above, the track's below) as an inline SVG: one
+// colour per label, blank where there is none. Empty when neither side
+// names a label. Rows: (frame, truth, found), frames increasing.
+std::string Timeline(const std::string& id, const std::string& title,
+                     const std::vector<std::tuple<int, std::string, std::string>>& rows) {
   std::vector<std::string> names;
   for (const auto& [frame, truth, found] : rows) {
     for (const std::string* n : {&truth, &found}) {
@@ -104,10 +124,10 @@ std::string GestureTimeline(const Score& score) {
   const int first = std::get<0>(rows.front()), last = std::get<0>(rows.back());
   const double width = 900, scale = width / std::max(1, last - first + 1);
   std::ostringstream svg;
-  svg << "<h3>Gestures over time <small>(frames " << first << "–" << last
-      << "; top: truth, bottom: recognised)</small></h3>\n<svg id=\"gesture-timeline\" width=\"" << width + 90
+  svg << "<h3>" << Escape(title) << " <small>(frames " << first << "–" << last
+      << "; top: truth, bottom: tracked)</small></h3>\n<svg id=\"" << id << "\" width=\"" << width + 90
       << "\" height=\"70\" xmlns=\"http://www.w3.org/2000/svg\" font-size=\"11\">"
-      << "<text x=\"0\" y=\"16\">truth</text><text x=\"0\" y=\"44\">recognised</text>";
+      << "<text x=\"0\" y=\"16\">truth</text><text x=\"0\" y=\"44\">tracked</text>";
   for (int lane = 0; lane < 2; ++lane) {
     size_t i = 0;
     while (i < rows.size()) {
@@ -159,8 +179,10 @@ std::string Tables(const Score& score) {
   if (!score.motion_confusion.empty()) {
     out << ConfusionTable("motion",
                           "Motion labels <small>(thesis Tables 7.1–7.2; rows truth, columns tracked; accuracy " +
-                              Fixed(100 * score.motion.rate(), 2) + " %)</small>",
-                          score.motion_confusion);
+                              Fixed(100 * score.motion.rate(), 2) + " %, mean per-label recall " +
+                              Fixed(100 * MeanRecall(score.motion_confusion), 2) + " %)</small>",
+                          score.motion_confusion)
+        << MotionRecallTable(score.motion_confusion);
   }
   if (!score.posture_confusion.empty()) {
     out << ConfusionTable("postures",
@@ -592,7 +614,12 @@ ReportResult WriteReport(const Score& score, const ReportOptions& options, const
        << "<p class=\"meta\"><span><b>sequence</b> " << Escape(fs::absolute(options.sequence).lexically_normal().string())
        << "</span> <span><b>track</b> " << Escape(fs::absolute(options.track).lexically_normal().string())
        << "</span></p>\n<h2>Tables</h2>\n"
-       << Tables(score) << GestureTimeline(score) << "<h2>Plots</h2>\n";
+       << Tables(score) << Timeline("gesture-timeline", "Gestures over time", score.gesture_timeline);
+  for (const auto& [side, rows] : score.motion_timeline) {
+    if (score.motion.total == 0) break;  // a track without motion labels
+    html << Timeline("motion-timeline-" + side, "Motion labels of the " + side + " arm over time", rows);
+  }
+  html << "<h2>Plots</h2>\n";
   if (result.plots) {
     for (const auto& [name, title] : std::vector<std::pair<std::string, std::string>>{
              {"joint_histograms", "Joint error histograms (Fig. 6.8)"},

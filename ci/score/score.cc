@@ -68,6 +68,86 @@ std::vector<std::string> ConfusionLabels(const std::map<std::string, std::map<st
   return labels;
 }
 
+const std::vector<std::string>& ThesisMotionLabels() {
+  static const std::vector<std::string> labels = {"REST", "PAUSE",   "UP",       "DOWN", "LEFT",
+                                                  "RIGHT", "FORWARD", "BACKWARD", "OTHER"};
+  return labels;
+}
+
+double ThesisMotionRecall(const std::string& model, const std::string& label) {
+  // The diagonals of Table 7.1 (CRF, mean 74.3 %) and Table 7.2 (LDCRF, mean 85.5 %).
+  static const double crf[] = {0.962, 0.858, 0.745, 0.708, 0.633, 0.738, 0.778, 0.500, 0.767};
+  static const double ldcrf[] = {0.9940, 0.8678, 0.7766, 0.8566, 0.8613, 0.8689, 0.6667, 0.9978, 0.8034};
+  const std::vector<std::string>& labels = ThesisMotionLabels();
+  if (model != "crf" && model != "ldcrf") return std::nan("");
+  for (size_t i = 0; i < labels.size(); ++i) {
+    if (labels[i] == label) return model == "crf" ? crf[i] : ldcrf[i];
+  }
+  return std::nan("");
+}
+
+std::map<std::string, double> PerLabelRecall(const std::map<std::string, std::map<std::string, int>>& confusion) {
+  std::map<std::string, double> recall;
+  for (const auto& [truth, row] : confusion) {
+    int total = 0;
+    for (const auto& [found, n] : row) total += n;
+    const auto self = row.find(truth);
+    if (total > 0) recall[truth] = double(self == row.end() ? 0 : self->second) / total;
+  }
+  return recall;
+}
+
+double MeanRecall(const std::map<std::string, std::map<std::string, int>>& confusion) {
+  const std::map<std::string, double> recall = PerLabelRecall(confusion);
+  double sum = 0;
+  for (const auto& [label, r] : recall) sum += r;
+  return recall.empty() ? std::nan("") : sum / recall.size();
+}
+
+std::string MotionConfusionMarkdown(const std::map<std::string, std::map<std::string, int>>& confusion) {
+  std::vector<std::string> labels;
+  const std::vector<std::string> present = ConfusionLabels(confusion);
+  for (const std::string& l : ThesisMotionLabels()) {
+    if (std::find(present.begin(), present.end(), l) != present.end()) labels.push_back(l);
+  }
+  for (const std::string& l : present) {
+    if (std::find(labels.begin(), labels.end(), l) == labels.end()) labels.push_back(l);
+  }
+  std::ostringstream out;
+  out << "| truth \\ found |";
+  for (const std::string& l : labels) out << " " << l << " |";
+  out << "\n|---|";
+  for (size_t i = 0; i < labels.size(); ++i) out << "---:|";
+  out << "\n";
+  std::map<std::string, int> totals;
+  for (const std::string& t : labels) {
+    const auto row = confusion.find(t);
+    if (row == confusion.end()) continue;
+    int total = 0;
+    for (const auto& [found, n] : row->second) total += n;
+    totals[t] = total;
+    out << "| " << t << " |";
+    for (const std::string& l : labels) {
+      const auto c = row->second.find(l);
+      const int n = c == row->second.end() ? 0 : c->second;
+      out << " " << (n ? Fixed(double(n) / total, 3) : std::string("")) << " |";
+    }
+    out << "\n";
+  }
+  const std::map<std::string, double> recall = PerLabelRecall(confusion);
+  out << "\n| label | frames | recall | thesis CRF | thesis LDCRF |\n|---|---:|---:|---:|---:|\n";
+  for (const std::string& l : labels) {
+    const auto r = recall.find(l);
+    if (r == recall.end()) continue;
+    const double crf = ThesisMotionRecall("crf", l), ldcrf = ThesisMotionRecall("ldcrf", l);
+    out << "| " << l << " | " << totals[l] << " | " << Fixed(100 * r->second, 1) << " % | "
+        << (std::isnan(crf) ? "" : Fixed(100 * crf, 1) + " %") << " | "
+        << (std::isnan(ldcrf) ? "" : Fixed(100 * ldcrf, 1) + " %") << " |\n";
+  }
+  out << "| **mean** | | **" << Fixed(100 * MeanRecall(confusion), 1) << " %** | 74.3 % | 85.5 % |\n";
+  return out.str();
+}
+
 namespace {
 
 // "A1+A3": an unordered pair of atom names, in order.
@@ -285,9 +365,11 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
       const std::string truth_label = (*truth_motion)[side];
       if (!track_motion || !track_motion->contains(side) || !(*track_motion)[side].is_string()) {
         ++score.motion.missing;
+        score.motion_timeline[side].emplace_back(frame, truth_label, "");
         continue;
       }
       const std::string label = (*track_motion)[side];
+      score.motion_timeline[side].emplace_back(frame, truth_label, label);
       ++score.motion_confusion[truth_label][label];
       ++score.motion.total;
       score.motion.correct += label == truth_label;
@@ -360,7 +442,11 @@ nlohmann::json Score::ToJson() const {
     j["rest"][side] = {{"accuracy", a.total ? Json(a.rate()) : Json(nullptr)},
                        {"correct", a.correct}, {"total", a.total}, {"missing", a.missing}};
   }
+  Json recall = Json::object();
+  for (const auto& [label, r] : PerLabelRecall(motion_confusion)) recall[label] = r;
   j["motion_labels"] = {{"accuracy", motion.total ? Json(motion.rate()) : Json(nullptr)},
+                        {"mean_recall", motion.total ? Json(MeanRecall(motion_confusion)) : Json(nullptr)},
+                        {"recall", recall},
                         {"total", motion.total},
                         {"missing", motion.missing},
                         {"confusion", motion_confusion}};
@@ -403,9 +489,11 @@ std::string Score::Markdown() const {
         << " | " << a.missing << " |\n";
   }
   if (!motion_confusion.empty()) {
-    out << "\n**Motion labels** (thesis Tables 7.1-7.2; rows truth, columns tracked; accuracy "
-        << Fixed(100 * motion.rate(), 2) << "%)\n\n"
-        << ConfusionMarkdown(motion_confusion);
+    out << "\n**Motion labels** (thesis Tables 7.1-7.2; rows truth, columns tracked, shares of the row; "
+        << motion.total << " arm-frames, " << motion.missing << " without a label; accuracy "
+        << Fixed(100 * motion.rate(), 2) << "%, mean per-label recall " << Fixed(100 * MeanRecall(motion_confusion), 2)
+        << "%)\n\n"
+        << MotionConfusionMarkdown(motion_confusion);
   }
   if (!posture_confusion.empty()) {
     out << "\n**Postures** (thesis 5.1: atom pairs, unordered; rows truth, columns recognised; "

@@ -55,6 +55,21 @@ std::string Fixed(double v, int digits);
 // side, sorted: its tables' rows and columns.
 std::vector<std::string> ConfusionLabels(const std::map<std::string, std::map<std::string, int>>& confusion);
 
+// Motion labels (thesis 7.1): the nine labels in the order of Tables 7.1 and
+// 7.2, and each table's diagonal (the per-label recall the thesis measured)
+// for model "crf" (Table 7.1) or "ldcrf" (Table 7.2); NaN for another.
+const std::vector<std::string>& ThesisMotionLabels();
+double ThesisMotionRecall(const std::string& model, const std::string& label);
+// Per truth label, the share of its frames labelled as itself; and the mean
+// of those over the labels the truth has.
+std::map<std::string, double> PerLabelRecall(const std::map<std::string, std::map<std::string, int>>& confusion);
+double MeanRecall(const std::map<std::string, std::map<std::string, int>>& confusion);
+// A motion-label confusion matrix in the shape of Tables 7.1-7.2: rows truth,
+// columns found, row shares, the thesis's labels first in its order; then
+// per label the frames, our recall and the thesis's CRF and LDCRF recall,
+// and the means.
+std::string MotionConfusionMarkdown(const std::map<std::string, std::map<std::string, int>>& confusion);
+
 // The nine joints of Table 6.1, in its order.
 const std::vector<std::string>& ScoredJoints();
 
@@ -76,6 +91,9 @@ struct Score {
   // Motion labels: truth label -> tracked label -> count, both arms together.
   std::map<std::string, std::map<std::string, int>> motion_confusion;
   Accuracy motion;
+  // Per arm ("right", "left"), per frame with a truth label: the truth's
+  // label and the track's ("" for none), for the report's timelines.
+  std::map<std::string, std::vector<std::tuple<int, std::string, std::string>>> motion_timeline;
   // Postures (thesis 5.1): the truth's [primary, secondary] atoms against the
   // tracker's recognised pair, as unordered pairs ("A1+A3", names in
   // order); truth pair -> recognised pair -> count.

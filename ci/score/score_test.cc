@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
@@ -44,6 +45,32 @@ TEST(ChauvenetTest, RemovesOnlyTheFarSamples) {
   EXPECT_EQ(s.missing, 4);
   EXPECT_NEAR(s.mean, 3.0, 1e-12);
   EXPECT_NEAR(s.std, 0.0, 1e-6);
+}
+
+// Per-label recall by hand; the thesis's diagonals give its stated means
+// (74.3 % CRF, 85.5 % LDCRF).
+TEST(MotionLabelTablesTest, RecallAndTheThesisDiagonals) {
+  const std::map<std::string, std::map<std::string, int>> c = {
+      {"REST", {{"REST", 9}, {"PAUSE", 1}}}, {"UP", {{"UP", 1}, {"OTHER", 3}}}, {"LEFT", {{"none", 2}}}};
+  const auto r = PerLabelRecall(c);
+  EXPECT_DOUBLE_EQ(r.at("REST"), 0.9);
+  EXPECT_DOUBLE_EQ(r.at("UP"), 0.25);
+  EXPECT_DOUBLE_EQ(r.at("LEFT"), 0.0);
+  EXPECT_EQ(r.count("PAUSE"), 0u);  // not a truth label here
+  EXPECT_DOUBLE_EQ(MeanRecall(c), (0.9 + 0.25 + 0.0) / 3);
+  double crf = 0, ldcrf = 0;
+  for (const std::string& l : ThesisMotionLabels()) {
+    crf += ThesisMotionRecall("crf", l);
+    ldcrf += ThesisMotionRecall("ldcrf", l);
+  }
+  EXPECT_NEAR(100 * crf / 9, 74.3, 0.05);
+  EXPECT_NEAR(100 * ldcrf / 9, 85.5, 0.05);
+  EXPECT_TRUE(std::isnan(ThesisMotionRecall("hmm", "REST")));
+  const std::string md = MotionConfusionMarkdown(c);
+  // Rows in the thesis's order (REST before UP before LEFT), shares of the row.
+  EXPECT_LT(md.find("\n| REST | 0.900 |"), md.find("\n| UP |"));
+  EXPECT_LT(md.find("\n| UP |"), md.find("\n| LEFT |"));
+  EXPECT_NE(md.find("| UP | 4 | 25.0 % | 74.5 % | 77.7 % |"), std::string::npos) << md;
 }
 
 class ScoreTest : public ::testing::Test {

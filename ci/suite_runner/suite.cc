@@ -50,7 +50,7 @@ const std::vector<std::string>& KnownMetrics() {
   static const std::vector<std::string> m = [] {
     std::vector<std::string> out = {"silhouette_iou_median", "tracked_fraction", "arms_mean_cm",
                                     "pointing_mean_deg", "rest_accuracy", "posture_accuracy",
-                                    "gesture_identification"};
+                                    "gesture_identification", "motion_mean_recall"};
     for (const std::string& joint : ScoredJoints()) out.push_back(joint + "_mean_cm");
     return out;
   }();
@@ -301,6 +301,10 @@ Measured RunScenario(const Scenario& sc, const std::string& suite, const fs::pat
     metrics["gesture_identification"] = score.gesture.rate();
     out.weights["gesture_identification"] = score.gesture.total;
   }
+  if (score.motion.total > 0) {
+    metrics["motion_mean_recall"] = MeanRecall(score.motion_confusion);
+    out.weights["motion_mean_recall"] = score.motion.total;
+  }
   if (arm_joints) metrics["arms_mean_cm"] = arms / arm_joints;
   // Pointing: the kept samples of both hands together.
   double pointing = 0;
@@ -421,7 +425,7 @@ void WriteSummary(SuiteResult& result, const fs::path& dir) {
 std::string SuiteResult::PooledTable() const {
   std::ostringstream out;
   out << "| motion | person | scenarios | present frames | root | waist | neck | shoulders | elbows | wrists | arms | "
-         "rest | tracked | postures | gestures |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "rest | tracked | postures | gestures | motion labels |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   const auto cm = [](const PooledRow& r, const std::string& m) {
     const auto it = r.metrics.find(m);
     return it == r.metrics.end() ? std::string("–") : Fixed(it->second, 2);
@@ -440,7 +444,8 @@ std::string SuiteResult::PooledTable() const {
         << cm(r, "root_mean_cm") << " | " << cm(r, "waist_mean_cm") << " | " << cm(r, "neck_mean_cm") << " | "
         << pair(r, "shoulder") << " | " << pair(r, "elbow") << " | " << pair(r, "wrist") << " | "
         << cm(r, "arms_mean_cm") << " | " << pct(r, "rest_accuracy") << " | " << pct(r, "tracked_fraction") << " | "
-        << pct(r, "posture_accuracy") << " | " << pct(r, "gesture_identification") << " |\n";
+        << pct(r, "posture_accuracy") << " | " << pct(r, "gesture_identification") << " | "
+        << pct(r, "motion_mean_recall") << " |\n";
   }
   return out.str();
 }

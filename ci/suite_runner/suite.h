@@ -28,6 +28,9 @@
 //                           when the tracker has posture atoms)
 //   gesture_identification  performances identified (0..1; when the tracker
 //                           has gesture models and the motion has gestures)
+//   motion_mean_recall      motion labels: the mean over truth labels of each
+//                           label's recall, both arms (0..1; thesis 7.2; when
+//                           the tracker has a motion-label model)
 
 #include <filesystem>
 #include <map>

@@ -126,6 +126,9 @@ LiveReport RunLiveJob(const LiveJobOptions& options) {
       const double dt = (last_frame < 0 ? 1 : f - last_frame) / input.fps();
       const FrameTracker::Step step = tracker.Track(f, std::move(images), problems, dt);
       if (!publisher.Publish(step.track_line, dropped)) ++report.send_failures;
+      for (const MotionLabeler::Labels& l : step.motion) {
+        if (l.arms && !publisher.PublishMotion(l.frame, (*l.arms)[0], (*l.arms)[1])) ++report.send_failures;
+      }
       latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - arrival).count());
       record += step.track_line.dump() + "\n";
       last_frame = f;

@@ -111,13 +111,18 @@ bool OscPublisher::Publish(const nlohmann::json& line, int dropped) {
     lo_message_add_int32(m, gesture.value("start_frame", 0));
     add("/irbench/gesture", m);
   }
-  if (line["motion"].is_string()) {
-    lo_message m = lo_message_new();
-    lo_message_add_string(m, line["motion"].get<std::string>().c_str());
-    add("/irbench/motion", m);
-  }
   const int sent = lo_send_bundle(address_->address, bundle);
   lo_bundle_free_recursive(bundle);
+  return sent >= 0;
+}
+
+bool OscPublisher::PublishMotion(int frame, const std::string& right, const std::string& left) {
+  lo_message m = lo_message_new();
+  lo_message_add_int32(m, frame);
+  lo_message_add_string(m, right.c_str());
+  lo_message_add_string(m, left.c_str());
+  const int sent = lo_send_message(address_->address, "/irbench/motion", m);
+  lo_message_free(m);
   return sent >= 0;
 }
 

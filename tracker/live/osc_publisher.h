@@ -27,6 +27,10 @@ class OscPublisher {
   // as one bundle; `dropped`: frame-sets dropped so far. False when the send
   // failed (the receiver is not there: UDP does not care).
   bool Publish(const nlohmann::json& track_line, int dropped);
+  // The motion labels of frame `frame` (thesis 7.1), which come the
+  // labeller's latency after the frame's bundle: /irbench/motion
+  // frame right left.
+  bool PublishMotion(int frame, const std::string& right, const std::string& left);
 
  private:
   struct Address;

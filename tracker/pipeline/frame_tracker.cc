@@ -230,7 +230,9 @@ FrameTracker::FrameTracker(const SequenceInput& input,
       left_out_counts_(input.cameras().size()) {
   if (settings.stage == TrackStage::kPose) {
     pose_tracker_.emplace(input.cameras(), input.screens(), settings.pose);
-    if (rest_classifier) pose_tracker_->set_rest_classifier(std::move(rest_classifier));
+    if (rest_classifier) pose_tracker_->set_rest_classifier(rest_classifier);
+    rest_classifier_ = std::move(rest_classifier);
+    LoadMotionLabeler(settings);
   }
   const fs::path atoms = settings.posture_atoms.empty() ? DefaultPostureAtomsPath() : settings.posture_atoms;
   if (!settings.posture_atoms.empty() || fs::exists(atoms)) {
@@ -251,6 +253,33 @@ FrameTracker::FrameTracker(const SequenceInput& input,
     gesture_models_path_ = gestures;
     gesture_recognizer_.emplace(gesture_models_, settings.gesture_model);
   }
+}
+
+void FrameTracker::LoadMotionLabeler(const TrackerSettings& settings) {
+  if (settings.motion_model == MotionModelChoice::kNone) return;
+  const MotionModelKind kind =
+      settings.motion_model == MotionModelChoice::kCrf ? MotionModelKind::kCrf : MotionModelKind::kLdcrf;
+  const fs::path path = settings.motion_labels.empty() ? DefaultMotionLabelModelPath(kind) : settings.motion_labels;
+  if (settings.motion_labels.empty() && !fs::exists(path)) {
+    Log().warn("track: no motion-label model at {} (irbench train motion-labels); motion stays null", path.string());
+    return;
+  }
+  auto model = std::make_shared<MotionLabelModel>(MotionLabelModel::Load(path));
+  if (model->kind != kind) {
+    throw InputError(path.string(), "kind", std::string("is ") + MotionModelKindName(model->kind) +
+                                                ", --motion-model asks for " + MotionModelKindName(kind));
+  }
+  motion_labels_path_ = path;
+  motion_labeler_.emplace(std::move(model));
+}
+
+std::vector<MotionLabeler::Labels> FrameTracker::FinishMotion() {
+  return motion_labeler_ ? motion_labeler_->Finish() : std::vector<MotionLabeler::Labels>{};
+}
+
+nlohmann::json FrameTracker::MotionJson(const MotionLabeler::Labels& labels) {
+  if (!labels.arms) return nullptr;
+  return {{"right", (*labels.arms)[0]}, {"left", (*labels.arms)[1]}};
 }
 
 FrameTracker::Step FrameTracker::Track(int f,
@@ -332,6 +361,12 @@ FrameTracker::Step FrameTracker::Track(int f,
     step.track_line["gesture"] = {{"label", gesture_models_->gestures[step.gesture->gesture]},
                                   {"score", std::round(step.gesture->score * 1e3) / 1e3},
                                   {"start_frame", step.gesture->start_frame}};
+  }
+  if (motion_labeler_) {
+    const auto motion_start = std::chrono::steady_clock::now();
+    step.motion = motion_labeler_->Update(f, MotionObservationFromTrackLine(step.track_line, rest_classifier_.get()));
+    line["ms"]["motion_labels"] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - motion_start).count();
   }
   step.track_line["ms"] = line["ms"];
   step.images = std::move(images);

@@ -18,6 +18,7 @@
 #include "tracker/pipeline/track_settings.h"
 #include "tracker/pose/pose_tracker.h"
 #include "tracker/gesture/gesture_recognizer.h"
+#include "tracker/motion_labels/motion_labeler.h"
 #include "tracker/posture/decompose.h"
 #include "tracker/shape/shape_descriptor.h"
 
@@ -50,6 +51,9 @@ class FrameTracker {
     std::optional<Posture> posture;
     // The online gesture decision (thesis 5.2), when the tracker has models.
     std::optional<GestureDecision> gesture;
+    // Motion labels (thesis 7.1) that became final at this frame-set, for
+    // this or earlier frames (the model's window late), in frame order.
+    std::vector<MotionLabeler::Labels> motion;
     nlohmann::json features_line;  // features.jsonl's line, with "ms"
     nlohmann::json track_line;     // track.jsonl's line, with "ms"
   };
@@ -58,16 +62,26 @@ class FrameTracker {
   // changes.
   Step Track(int f, std::vector<cv::Mat> images, const std::vector<std::string>& problems, double dt);
 
+  // The motion labels still pending after the last frame-set.
+  std::vector<MotionLabeler::Labels> FinishMotion();
+  // A track.jsonl "motion" value: {"right", "left"} or null.
+  static nlohmann::json MotionJson(const MotionLabeler::Labels& labels);
+
   double train_ms() const { return train_ms_; }
   // The posture atoms' file in use; empty when posture recognition is off.
   const std::filesystem::path& posture_atoms_path() const { return posture_atoms_path_; }
   // The gesture models' file in use; empty when gesture recognition is off.
   const std::filesystem::path& gesture_models_path() const { return gesture_models_path_; }
+  // The motion-label model's file in use and its kind; empty when off.
+  const std::filesystem::path& motion_labels_path() const { return motion_labels_path_; }
+  const MotionLabeler* motion_labeler() const { return motion_labeler_ ? &*motion_labeler_ : nullptr; }
   const FrontEnd& front_end() const { return front_end_; }
   // Per camera, how many frame-sets it was left out of, by reason.
   const std::vector<std::map<std::string, int>>& left_out_counts() const { return left_out_counts_; }
 
  private:
+  void LoadMotionLabeler(const TrackerSettings& settings);
+
   const SequenceInput& input_;
   double train_ms_ = 0;
   FrontEnd front_end_;
@@ -79,6 +93,9 @@ class FrameTracker {
   std::filesystem::path gesture_models_path_;
   std::shared_ptr<const GestureModels> gesture_models_;
   std::optional<GestureRecognizer> gesture_recognizer_;
+  std::shared_ptr<const RestClassifier> rest_classifier_;
+  std::filesystem::path motion_labels_path_;
+  std::optional<MotionLabeler> motion_labeler_;
   CameraHealthMonitor health_;
   std::vector<CameraHealth> last_health_;  // per camera, to warn on changes
   std::vector<std::map<std::string, int>> left_out_counts_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -109,6 +110,10 @@ void CheckOutputOutsideSequence(const TrackJobOptions& options) {
   inputs.push_back(options.tracker.rest_model.empty() ? DefaultRestModelPath() : options.tracker.rest_model);
   inputs.push_back(options.tracker.posture_atoms.empty() ? DefaultPostureAtomsPath() : options.tracker.posture_atoms);
   inputs.push_back(options.tracker.gesture_models.empty() ? DefaultGestureModelsPath() : options.tracker.gesture_models);
+  if (!options.tracker.motion_labels.empty()) inputs.push_back(options.tracker.motion_labels);
+  for (MotionModelKind kind : {MotionModelKind::kCrf, MotionModelKind::kLdcrf}) {
+    inputs.push_back(DefaultMotionLabelModelPath(kind));
+  }
   CheckOutputApart(out, inputs, "--out");
 }
 
@@ -121,6 +126,26 @@ struct TrackRun {
   std::string lines, track_lines;
   std::optional<NpyRowWriter> descriptors;
   int descriptor_bins = 0;
+  // track.jsonl lines waiting for their motion labels (the labeller's
+  // latency), oldest first.
+  std::deque<nlohmann::json> pending;
+
+  // Puts motion labels on their pending lines, then writes out every line
+  // the labeller is done with (all of them when `all`).
+  void PutMotion(const std::vector<MotionLabeler::Labels>& labels, bool all) {
+    int done_through = -1;
+    for (const MotionLabeler::Labels& l : labels) {
+      for (nlohmann::json& line : pending) {
+        if (line["frame"].get<int>() == l.frame) line["motion"] = FrameTracker::MotionJson(l);
+      }
+      done_through = l.frame;
+    }
+    while (!pending.empty() &&
+           (all || !tracker.motion_labeler() || pending.front()["frame"].get<int>() <= done_through)) {
+      track_lines += pending.front().dump() + "\n";
+      pending.pop_front();
+    }
+  }
 };
 
 // Tracks frame f: the silhouettes (and overlays, PLY) written, a line
@@ -152,7 +177,8 @@ void TrackFrame(int f, TrackRun& run) {
     run.descriptors->Append(step.shape ? step.shape->bins : std::vector<float>(run.descriptor_bins, 0.0f));
   }
   run.lines += step.features_line.dump() + "\n";
-  run.track_lines += step.track_line.dump() + "\n";
+  run.pending.push_back(step.track_line);
+  run.PutMotion(step.motion, false);
 }
 
 }  // namespace
@@ -182,7 +208,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
   Log().info("track: background models for {} cameras from {} empty-stage frames in {:.0f} ms",
              input.cameras().size(), input.background_count(), train_ms);
   const size_t nc = input.cameras().size();
-  TrackRun run{options, input, tracker, root, "", "", std::nullopt, ShapeDescriptorOptions().bin_count()};
+  TrackRun run{options, input, tracker, root, "", "", std::nullopt, ShapeDescriptorOptions().bin_count(), {}};
   if (options.descriptors) run.descriptors.emplace(root / "descriptors.npy", frames, run.descriptor_bins);
   for (size_t c = 0; c < nc; ++c) {
     if (input.MissingFrames()[c] > 0) {
@@ -199,6 +225,7 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
       progress.Set(f + 1, "frame");
     }
   }
+  run.PutMotion(tracker.FinishMotion(), true);
   if (run.descriptors) run.descriptors->Close();
   AtomicWriteFile(root / "features.jsonl", run.lines);
   AtomicWriteFile(root / "track.jsonl", run.track_lines);
@@ -245,6 +272,12 @@ fs::path RunTrackJob(const TrackJobOptions& options) {
     models["gestures"] = {{"file", fs::absolute(tracker.gesture_models_path()).lexically_normal().string()},
                           {"sha256", Sha256OfFile(tracker.gesture_models_path())},
                           {"kind", GestureModelKindName(settings.gesture_model)}};
+  }
+  if (!tracker.motion_labels_path().empty()) {
+    models["motion_labels"] = {{"file", fs::absolute(tracker.motion_labels_path()).lexically_normal().string()},
+                               {"sha256", Sha256OfFile(tracker.motion_labels_path())},
+                               {"kind", MotionModelKindName(tracker.motion_labeler()->model().kind)},
+                               {"latency_frames", tracker.motion_labeler()->latency_frames()}};
   }
   meta["models"] = models;
   AtomicWriteFile(root / "track.json", meta.dump(2) + "\n");

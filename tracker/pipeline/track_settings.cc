@@ -77,6 +77,23 @@ std::vector<TrackSetting> MakeSettings() {
                ChoiceBinding{{"fhmm", "pahmm", "hmm"},
                              [](const TrackerSettings& t) -> std::string { return GestureModelKindName(t.gesture_model); },
                              [](TrackerSettings& t, const std::string& v) { t.gesture_model = *ParseGestureModelKind(v); }}});
+  s.push_back({"motion_model", "--motion-model",
+               "pose: which motion-label model labels the arms' motion (thesis 7.1): ldcrf, crf or none",
+               ChoiceBinding{{"ldcrf", "crf", "none"},
+                             [](const TrackerSettings& t) -> std::string {
+                               return t.motion_model == MotionModelChoice::kNone ? "none"
+                                      : t.motion_model == MotionModelChoice::kCrf ? "crf"
+                                                                                   : "ldcrf";
+                             },
+                             [](TrackerSettings& t, const std::string& v) {
+                               t.motion_model = v == "none" ? MotionModelChoice::kNone
+                                                : v == "crf" ? MotionModelChoice::kCrf
+                                                             : MotionModelChoice::kLdcrf;
+                             }}});
+  s.push_back(
+      {"motion_labels", "--motion-labels",
+       "pose: motion-label model file (default: tracker/models/motion_<--motion-model>.json when present)",
+       PathBinding{[](TrackerSettings& t) -> std::filesystem::path& { return t.motion_labels; }}});
   s.push_back({"background_model", "--background-model",
                "flicker (light-following, pooled) or plain (the thesis's per-pixel Gaussian)",
                ChoiceBinding{{"flicker", "plain"},

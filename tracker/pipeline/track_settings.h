@@ -17,12 +17,16 @@
 #include "common/json_reader.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/gesture/gesture_models.h"
+#include "tracker/motion_labels/motion_label_model.h"
 #include "tracker/pose/pose_tracker.h"
 
 namespace irbench {
 
 // What `irbench track` runs: the front end alone, or the pose tracker after it.
 enum class TrackStage { kFeatures, kPose };
+
+// Which motion-label model labels the arms (thesis 7.1), or none.
+enum class MotionModelChoice { kLdcrf, kCrf, kNone };
 
 // Everything that decides what the tracker computes (not where it writes).
 struct TrackerSettings {
@@ -45,6 +49,11 @@ struct TrackerSettings {
   // it and the posture atoms exist, else gesture stays null.
   std::filesystem::path gesture_models;
   GestureModelKind gesture_model = GestureModelKind::kFactorialHmm;
+  // pose: the motion-label model (irbench train motion-labels); empty path:
+  // tracker/models/motion_<motion_model>.json when it exists, else motion
+  // stays null.
+  std::filesystem::path motion_labels;
+  MotionModelChoice motion_model = MotionModelChoice::kLdcrf;
 };
 
 // The binding kinds. `ref` gives the setting's field in a TrackerSettings.

@@ -1,6 +1,7 @@
 #include "tracker/pose/rest_state.h"
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <numeric>
 #include <opencv2/ml.hpp>
 #include <random>
@@ -129,6 +130,15 @@ bool RestClassifier::AtRest(const std::array<float, 6>& features) const {
   if (empty()) return false;
   cv::Mat row(1, 6, CV_32F, const_cast<float*>(features.data()));
   return impl_->svm->predict(row) > 0.5;
+}
+
+double RestClassifier::Margin(const std::array<float, 6>& features) const {
+  if (empty()) return 0;
+  cv::Mat row(1, 6, CV_32F, const_cast<float*>(features.data()));
+  // OpenCV's raw decision value has the sign of its internal class order;
+  // the label decides the sign here.
+  const double raw = std::abs(impl_->svm->predict(row, cv::noArray(), cv::ml::StatModel::RAW_OUTPUT));
+  return AtRest(features) ? raw : -raw;
 }
 
 bool RestClassifier::empty() const { return !impl_->svm || !impl_->svm->isTrained(); }

@@ -41,6 +41,10 @@ class RestClassifier {
   void Save(const std::filesystem::path& path) const;  // atomic
 
   bool AtRest(const std::array<float, 6>& features) const;
+  // The SVM's decision value: positive at rest, negative not, its size the
+  // distance from the boundary in the kernel's units (thesis 7.1.3 uses it
+  // as a motion-label feature); 0 when empty.
+  double Margin(const std::array<float, 6>& features) const;
   bool empty() const;
 
  private:
