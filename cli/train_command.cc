@@ -153,6 +153,10 @@ Command AddTrainMotionLabels(CLI::App* train_cmd) {
                   "per-label recall) or max_marginal (largest p(label | x))")
       ->capture_default_str()
       ->check(CLI::IsMember({"balanced", "max_marginal"}));
+  cmd->add_option("--prior-power", args->job.prior_power,
+                  "balanced decision: divide by the training shares to this power, 0-1")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--retrack", args->job.retrack, "track every sequence here even when it has a track/");
   cmd->add_option("--rest-model", args->rest, "rest-state SVM for the margin feature (default: the shipped one)");
   cmd->add_option("--table", args->table, "also write the tables as Markdown to this file");

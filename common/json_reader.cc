@@ -136,4 +136,22 @@ JsonNode ParseJsonFile(const std::string& path) {
   return ParseJsonString(buffer.str(), path);
 }
 
+Eigen::VectorXd JsonNode::FiniteVector(int size) const {
+  const std::vector<double> r = Numbers();
+  if (r.size() != static_cast<size_t>(size)) Fail("must have " + std::to_string(size) + " values");
+  Eigen::VectorXd v(size);
+  for (int i = 0; i < size; ++i) {
+    if (!std::isfinite(r[i])) Fail("values must be finite");
+    v(i) = r[i];
+  }
+  return v;
+}
+
+Eigen::MatrixXd JsonNode::FiniteMatrix(int rows, int cols) const {
+  if (Size() != static_cast<size_t>(rows)) Fail("must have " + std::to_string(rows) + " rows");
+  Eigen::MatrixXd m(rows, cols);
+  for (int i = 0; i < rows; ++i) m.row(i) = (*this)[i].FiniteVector(cols).transpose();
+  return m;
+}
+
 }  // namespace irbench

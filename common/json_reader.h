@@ -41,6 +41,10 @@ class JsonNode {
   Eigen::Vector3d Vec3() const;
   Eigen::Vector2d Vec2() const;
   std::vector<double> Numbers() const;
+  // An array of `size` finite numbers; an array of `rows` arrays of `cols`
+  // finite numbers (model files' vectors and matrices).
+  Eigen::VectorXd FiniteVector(int size) const;
+  Eigen::MatrixXd FiniteMatrix(int rows, int cols) const;
 
   double GetDouble(const std::string& key) const { return (*this)[key].Number(); }
   double GetDouble(const std::string& key, double fallback) const;

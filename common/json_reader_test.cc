@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
 namespace irbench {
 namespace {
 
@@ -42,6 +44,24 @@ TEST(JsonReaderTest, UnknownKeysAreRejected) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "fxx");
   }
+}
+
+// Model files' matrices: sizes and finiteness checked, the bad row named.
+TEST(JsonReaderTest, FiniteVectorsAndMatrices) {
+  const JsonNode root = ParseJsonString(R"({"m": [[1, 2], [3, 4]], "v": [1, 2, 3], "r": [[1, 2], [3]]})", "m.json");
+  EXPECT_EQ(root["m"].FiniteMatrix(2, 2), (Eigen::Matrix2d() << 1, 2, 3, 4).finished());
+  EXPECT_EQ(root["v"].FiniteVector(3), Eigen::Vector3d(1, 2, 3));
+  const auto field_of = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return e.field() + ": " + e.message();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(field_of([&] { root["v"].FiniteVector(2); }), "v: must have 2 values");
+  EXPECT_EQ(field_of([&] { root["m"].FiniteMatrix(3, 2); }), "m: must have 3 rows");
+  EXPECT_EQ(field_of([&] { root["r"].FiniteMatrix(2, 2); }), "r[1]: must have 2 values");
 }
 
 }  // namespace

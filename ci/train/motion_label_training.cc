@@ -158,6 +158,7 @@ MotionLabelModel Fit(MotionModelKind kind, const std::vector<std::pair<std::vect
     if (!(m.feature_scale(i) > 1e-9)) m.feature_scale(i) = 1;
   }
   m.decision = job.decision;
+  m.prior_power = job.prior_power;
   m.label_prior = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.labels.size()));
   for (const auto& [features, labels] : chains) {
     for (int l : labels) m.label_prior(l) += 1;

@@ -29,6 +29,7 @@ struct MotionLabelTrainingJob {
   int ldcrf_states = 2;              // thesis 7.2: 2 hidden states per label
   bool retrack = false;              // track every sequence even when it has a track
   MotionDecision decision = MotionDecision::kBalanced;
+  double prior_power = 1.0;
   CrfTrainingOptions options;
 };
 

@@ -59,31 +59,6 @@ nlohmann::json VectorJson(const Eigen::VectorXd& v) {
   return row;
 }
 
-Eigen::MatrixXd MatrixFrom(const JsonNode& node, int rows, int cols) {
-  if (node.Size() != static_cast<size_t>(rows)) node.Fail("must have " + std::to_string(rows) + " rows");
-  Eigen::MatrixXd m(rows, cols);
-  for (int i = 0; i < rows; ++i) {
-    const std::vector<double> r = node[i].Numbers();
-    if (r.size() != static_cast<size_t>(cols)) node[i].Fail("must have " + std::to_string(cols) + " values");
-    for (int j = 0; j < cols; ++j) {
-      if (!std::isfinite(r[j])) node[i].Fail("values must be finite");
-      m(i, j) = r[j];
-    }
-  }
-  return m;
-}
-
-Eigen::VectorXd VectorFrom(const JsonNode& node, int size) {
-  const std::vector<double> r = node.Numbers();
-  if (r.size() != static_cast<size_t>(size)) node.Fail("must have " + std::to_string(size) + " values");
-  Eigen::VectorXd v(size);
-  for (int i = 0; i < size; ++i) {
-    if (!std::isfinite(r[i])) node.Fail("values must be finite");
-    v(i) = r[i];
-  }
-  return v;
-}
-
 nlohmann::json ChainJson(const LogMarkovChain& c) {
   return {{"initial", VectorJson(c.log_initial.array().exp())},
           {"transition", MatrixJson(c.log_transition.array().exp())}};
@@ -92,7 +67,7 @@ nlohmann::json ChainJson(const LogMarkovChain& c) {
 LogMarkovChain ChainFrom(const JsonNode& node, int n) {
   node.CheckKeys({"initial", "transition"});
   const LogMarkovChain c =
-      LogMarkovChain::FromProbabilities(VectorFrom(node["initial"], n), MatrixFrom(node["transition"], n, n));
+      LogMarkovChain::FromProbabilities(node["initial"].FiniteVector(n), node["transition"].FiniteMatrix(n, n));
   try {
     c.Check();
   } catch (const std::invalid_argument& e) {
@@ -102,7 +77,7 @@ LogMarkovChain ChainFrom(const JsonNode& node, int n) {
 }
 
 Eigen::MatrixXd CovarianceFrom(const JsonNode& node, int d) {
-  Eigen::MatrixXd c = MatrixFrom(node, d, d);
+  Eigen::MatrixXd c = node.FiniteMatrix(d, d);
   if ((c - c.transpose()).cwiseAbs().maxCoeff() > 1e-9 * (1 + c.cwiseAbs().maxCoeff()) ||
       Eigen::LLT<Eigen::MatrixXd>(c).info() != Eigen::Success) {
     node.Fail("must be a symmetric positive definite matrix");
@@ -319,7 +294,7 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
     GaussianHmm hmm;
     const int states = static_cast<int>(h["chain"]["initial"].Size());
     hmm.chain = ChainFrom(h["chain"], states);
-    hmm.means = MatrixFrom(h["means"], states, d).transpose();
+    hmm.means = h["means"].FiniteMatrix(states, d).transpose();
     hmm.covariance = CovarianceFrom(h["covariance"], d);
     m.hmm.push_back(hmm);
     const JsonNode p = e["pahmm"];
@@ -328,7 +303,7 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
     for (size_t c = 0; c < 2; ++c) {
       p[c].CheckKeys({"chain", "emission"});
       pa[c].chain = ChainFrom(p[c]["chain"], d);
-      const Eigen::MatrixXd b = MatrixFrom(p[c]["emission"], d, d);
+      const Eigen::MatrixXd b = p[c]["emission"].FiniteMatrix(d, d);
       for (int i = 0; i < d; ++i) {
         if ((b.row(i).array() < 0).any() || std::abs(b.row(i).sum() - 1) > 1e-6) {
           p[c]["emission"][i].Fail("must be probabilities summing to 1");
@@ -346,7 +321,7 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
     for (size_t c = 0; c < f["chains"].Size(); ++c) {
       const int k = static_cast<int>(f["chains"][c]["initial"].Size());
       fh.chains.push_back(ChainFrom(f["chains"][c], k));
-      fh.weights.push_back(MatrixFrom(f["weights"][c], d, k));
+      fh.weights.push_back(f["weights"][c].FiniteMatrix(d, k));
     }
     fh.covariance = CovarianceFrom(f["covariance"], d);
     try {

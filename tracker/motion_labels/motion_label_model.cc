@@ -12,27 +12,10 @@ namespace {
 
 constexpr const char* kFormat = "irbench.motion-labels/1";
 
-Eigen::MatrixXd MatrixFrom(const JsonNode& node, int rows, int cols) {
-  if (node.Size() != static_cast<size_t>(rows)) node.Fail("must have " + std::to_string(rows) + " rows");
-  Eigen::MatrixXd m(rows, cols);
-  for (int i = 0; i < rows; ++i) {
-    const std::vector<double> r = node[i].Numbers();
-    if (r.size() != static_cast<size_t>(cols)) node[i].Fail("must have " + std::to_string(cols) + " values");
-    for (int j = 0; j < cols; ++j) {
-      if (!std::isfinite(r[j])) node[i].Fail("values must be finite");
-      m(i, j) = r[j];
-    }
-  }
-  return m;
-}
-
-Eigen::VectorXd VectorFrom(const JsonNode& node, int size, bool positive) {
-  const std::vector<double> v = node.Numbers();
-  if (v.size() != static_cast<size_t>(size)) node.Fail("must have " + std::to_string(size) + " values");
-  for (double x : v) {
-    if (!std::isfinite(x) || (positive && !(x > 0))) node.Fail(positive ? "values must be finite and > 0" : "values must be finite");
-  }
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), size);
+Eigen::VectorXd PositiveVectorFrom(const JsonNode& node, int size) {
+  const Eigen::VectorXd v = node.FiniteVector(size);
+  if (!(v.array() > 0).all()) node.Fail("values must be > 0");
+  return v;
 }
 
 nlohmann::json Rows(const Eigen::MatrixXd& m) {
@@ -60,7 +43,7 @@ Eigen::MatrixXd MotionLabelModel::Standardize(const std::vector<MotionFeatures>&
 int MotionLabelModel::Decide(const Eigen::Ref<const Eigen::RowVectorXd>& marginals) const {
   int best = 0;
   if (decision == MotionDecision::kBalanced) {
-    (marginals.array() / label_prior.transpose().array()).maxCoeff(&best);
+    (marginals.array() / label_prior.transpose().array().pow(prior_power)).maxCoeff(&best);
   } else {
     marginals.maxCoeff(&best);
   }
@@ -70,7 +53,7 @@ int MotionLabelModel::Decide(const Eigen::Ref<const Eigen::RowVectorXd>& margina
 MotionLabelModel MotionLabelModel::Load(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
   root.CheckKeys({"format", "kind", "labels", "features", "states_per_label", "window", "feature_mean",
-                  "feature_scale", "decision", "label_prior", "state_weights", "transition", "provenance"});
+                  "feature_scale", "decision", "label_prior", "prior_power", "state_weights", "transition", "provenance"});
   if (root.GetString("format") != kFormat) {
     root["format"].Fail("must be " + std::string(kFormat) + " (got " + root.GetString("format") + ")");
   }
@@ -97,8 +80,8 @@ MotionLabelModel MotionLabelModel::Load(const std::filesystem::path& path) {
   if (m.kind == MotionModelKind::kCrf && k != 1) root["states_per_label"].Fail("must be 1 for a crf");
   if (window < 0 || window > 100) root["window"].Fail("must be 0 to 100");
   m.crf = LatentCrf(static_cast<int>(m.labels.size()), k, kMotionFeatureCount, window);
-  m.feature_mean = VectorFrom(root["feature_mean"], kMotionFeatureCount, false);
-  m.feature_scale = VectorFrom(root["feature_scale"], kMotionFeatureCount, true);
+  m.feature_mean = root["feature_mean"].FiniteVector(kMotionFeatureCount);
+  m.feature_scale = PositiveVectorFrom(root["feature_scale"], kMotionFeatureCount);
   const std::string decision = root.GetString("decision");
   if (decision == "balanced") {
     m.decision = MotionDecision::kBalanced;
@@ -107,9 +90,11 @@ MotionLabelModel MotionLabelModel::Load(const std::filesystem::path& path) {
   } else {
     root["decision"].Fail("must be balanced or max_marginal (got " + decision + ")");
   }
-  m.label_prior = VectorFrom(root["label_prior"], static_cast<int>(m.labels.size()), true);
-  m.crf.state_weights() = MatrixFrom(root["state_weights"], m.crf.states(), m.crf.window_dims());
-  m.crf.transition() = MatrixFrom(root["transition"], m.crf.states(), m.crf.states());
+  m.label_prior = PositiveVectorFrom(root["label_prior"], static_cast<int>(m.labels.size()));
+  m.prior_power = root.GetDouble("prior_power");
+  if (!(m.prior_power >= 0 && m.prior_power <= 1)) root["prior_power"].Fail("must be in 0..1");
+  m.crf.state_weights() = root["state_weights"].FiniteMatrix(m.crf.states(), m.crf.window_dims());
+  m.crf.transition() = root["transition"].FiniteMatrix(m.crf.states(), m.crf.states());
   if (!root["provenance"].raw().is_object()) root["provenance"].Fail("must be an object");
   m.provenance = root["provenance"].raw();
   return m;
@@ -127,6 +112,7 @@ void MotionLabelModel::Save(const std::filesystem::path& path) const {
   j["feature_scale"] = std::vector<double>(feature_scale.data(), feature_scale.data() + feature_scale.size());
   j["decision"] = decision == MotionDecision::kBalanced ? "balanced" : "max_marginal";
   j["label_prior"] = std::vector<double>(label_prior.data(), label_prior.data() + label_prior.size());
+  j["prior_power"] = prior_power;
   j["state_weights"] = Rows(crf.state_weights());
   j["transition"] = Rows(crf.transition());
   j["provenance"] = provenance;

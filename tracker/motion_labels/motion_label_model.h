@@ -20,9 +20,10 @@ const char* MotionModelKindName(MotionModelKind kind);  // "crf", "ldcrf"
 
 // How a frame's label follows from its label marginals p(l | x): the most
 // probable (kMaxMarginal), or the largest p(l | x) / p(l) with p(l) the
-// training frames' label shares (kBalanced: the Bayes rule for the mean
-// per-label recall, which the thesis's tables report; rare labels such as
-// BACKWARD are not swamped by REST).
+// training frames' label shares raised to `prior_power` (kBalanced; power
+// 1 is the Bayes rule for the mean per-label recall, which the thesis's
+// tables report: rare labels such as BACKWARD are not swamped by REST;
+// lower powers trust the marginals more).
 enum class MotionDecision { kMaxMarginal, kBalanced };
 
 struct MotionLabelModel {
@@ -32,6 +33,7 @@ struct MotionLabelModel {
   LatentCrf crf;
   MotionDecision decision = MotionDecision::kBalanced;
   Eigen::VectorXd label_prior;  // labels.size(): training shares, each > 0
+  double prior_power = 1.0;     // 0..1
   nlohmann::json provenance = nlohmann::json::object();
 
   // T x kMotionFeatureCount standardised rows: (f - mean) / scale.

@@ -137,6 +137,8 @@ TEST(MotionLabelModelTest, DecisionRules) {
   EXPECT_EQ(m.Decide(marginals), 0);
   m.decision = MotionDecision::kBalanced;
   EXPECT_EQ(m.Decide(marginals), 2);  // 0.71, 1.5, 2.0
+  m.prior_power = 0.25;
+  EXPECT_EQ(m.Decide(marginals), 0);  // 0.55, 0.45, 0.36
 }
 
 TEST(MotionLabelModelTest, SavesLoadsAndRejectsBadFiles) {
@@ -174,6 +176,7 @@ TEST(MotionLabelModelTest, SavesLoadsAndRejectsBadFiles) {
   expect_error([](nlohmann::json& j) { j["transition"].erase(0); }, "transition");
   expect_error([](nlohmann::json& j) { j["extra"] = 1; }, "extra");
   expect_error([](nlohmann::json& j) { j["decision"] = "vote"; }, "decision");
+  expect_error([](nlohmann::json& j) { j["prior_power"] = 2; }, "prior_power");
   expect_error([](nlohmann::json& j) { j["label_prior"][2] = -0.1; }, "label_prior");
   fs::remove_all(dir);
 }
