@@ -19,6 +19,8 @@
 #include "tests/test_util.h"
 #include "tests/track_figures.h"
 #include "tracker/live/live_job.h"
+#include "tracker/motion_labels/motion_labeler.h"
+#include "tracker/pose/rest_state.h"
 
 namespace irbench {
 namespace {
@@ -34,6 +36,7 @@ struct Heard {
   std::map<int, std::map<std::string, int>> rest;
   std::map<int, int> dropped;
   std::map<int, std::string> posture;
+  std::map<int, std::array<std::string, 2>> motion;  // frame -> right, left
 };
 
 int OnMessage(const char* path, const char* types, lo_arg** argv, int argc, lo_message, void* user) {
@@ -49,6 +52,8 @@ int OnMessage(const char* path, const char* types, lo_arg** argv, int argc, lo_m
     heard.rest[heard.frames.back()][&argv[0]->s] = argv[1]->i;
   } else if (p == "/irbench/posture" && std::string(types) == "s" && !heard.frames.empty()) {
     heard.posture[heard.frames.back()] = &argv[0]->s;
+  } else if (p == "/irbench/motion" && std::string(types) == "iss") {
+    heard.motion[argv[0]->i] = {&argv[1]->s, &argv[2]->s};
   }
   return 0;
 }
@@ -151,6 +156,23 @@ TEST_F(LiveTest, EveryTrackedFrameSetIsOneBundleWithTheRecordedJoints) {
   }
   EXPECT_GT(joints_compared, 10 * static_cast<int>(record.size()));
   EXPECT_GT(postures_compared, static_cast<int>(record.size()) / 2);  // the shipped posture atoms
+  // Motion labels, each frame's sent once its window is in (or at the end):
+  // what the shipped LDCRF's labeller makes of the recorded lines.
+  if (fs::exists(DefaultMotionLabelModelPath(MotionModelKind::kLdcrf))) {
+    const RestClassifier rest = RestClassifier::Load(DefaultRestModelPath());
+    MotionLabeler labeler(std::make_shared<MotionLabelModel>(
+        MotionLabelModel::Load(DefaultMotionLabelModelPath(MotionModelKind::kLdcrf))));
+    std::map<int, std::array<std::string, 2>> expected;
+    auto keep = [&](const std::vector<MotionLabeler::Labels>& labels) {
+      for (const auto& l : labels) {
+        if (l.arms) expected[l.frame] = *l.arms;
+      }
+    };
+    for (const nlohmann::json& line : record) keep(labeler.Update(line["frame"], MotionObservationFromTrackLine(line, &rest)));
+    keep(labeler.Finish());
+    EXPECT_GT(expected.size(), record.size() / 2);
+    EXPECT_EQ(heard.motion, expected);
+  }
   // What was tracked tracks the person: the recorded track against the truth.
   const irbench::testing::TrackFigures figures = irbench::testing::UpperBodyFigures(record, truth);
   EXPECT_GT(figures.Fraction(), 0.8);

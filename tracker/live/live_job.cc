@@ -135,6 +135,11 @@ LiveReport RunLiveJob(const LiveJobOptions& options) {
       ++report.tracked;
       progress.Set(f + 1, "frame");
     }
+    // The motion labels of the last frames, which waited for frames that
+    // will not come.
+    for (const MotionLabeler::Labels& l : tracker.FinishMotion()) {
+      if (l.arms && !publisher.PublishMotion(l.frame, (*l.arms)[0], (*l.arms)[1])) ++report.send_failures;
+    }
   } catch (...) {
     {
       std::lock_guard lock(box.mutex);
