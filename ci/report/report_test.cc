@@ -51,6 +51,9 @@ class ReportTest : public ::testing::Test {
       j["posture"] = {{"pair", t["labels"]["posture"]}};
       const int f = t["frame"];
       if (f >= 5 && f <= 15) j["gesture"] = {{"label", "flap_both"}, {"score", 1.0}, {"start_frame", 5}};
+      // Motion labels as the truth's, the right arm BACKWARD on frames 5-15.
+      j["motion"] = t["labels"]["motion"];
+      if (f >= 5 && f <= 15 && j["motion"].is_object()) j["motion"]["right"] = "BACKWARD";
       if (t["present"].get<bool>()) {
         const BodyShape shape = BodyShape::FromHeight(1.75);
         const BodyPose pose =
@@ -184,6 +187,12 @@ TEST_F(ReportTest, WithoutGnuplotThePageSaysSo) {
   EXPECT_NE(html.find("<table id=\"postures\">"), std::string::npos);
   EXPECT_NE(html.find("<svg id=\"gesture-timeline\""), std::string::npos);
   EXPECT_NE(html.find("<title>flap_both, frames 5–15</title>"), std::string::npos);
+  // Motion labels: the table with per-label recall, and a timeline per arm.
+  EXPECT_NE(html.find("<table id=\"motion-recall\">"), std::string::npos);
+  EXPECT_NE(html.find("<svg id=\"motion-timeline-left\""), std::string::npos);
+  const size_t right = html.find("<svg id=\"motion-timeline-right\"");
+  ASSERT_NE(right, std::string::npos);
+  EXPECT_NE(html.find("<title>BACKWARD, frames 5–15</title>", right), std::string::npos);
 }
 
 // Debian's Chromium, headless, as root: what the page printed to its console
