@@ -129,12 +129,11 @@ std::optional<std::array<MotionFeatures, 2>> MotionFeatureExtractor::Update(
   const MotionObservation& o = *observation;
   const Eigen::Matrix3d upper_from_world = UpperBodyFromWorld(o);
   std::array<MotionFeatures, 2> out;
+  // Into the upper-body frame, the left arm mirrored.
   for (int a = 0; a < 2; ++a) {
-    ArmSample s{o.t, upper_from_world * (o.elbow[a] - o.shoulder[a]), upper_from_world * (o.wrist[a] - o.shoulder[a])};
-    if (a == 1) {
-      s.elbow.x() = -s.elbow.x();
-      s.wrist.x() = -s.wrist.x();
-    }
+    Eigen::Matrix3d to_body = upper_from_world;
+    if (a == 1) to_body.row(0) = -to_body.row(0);
+    const ArmSample s{o.t, o.elbow[a] - o.shoulder[a], o.wrist[a] - o.shoulder[a]};
     std::deque<ArmSample>& h = history_[a];
     h.push_back(s);
     while (h.size() > static_cast<size_t>(kLongVelocityFrames + 1)) h.pop_front();
@@ -142,17 +141,18 @@ std::optional<std::array<MotionFeatures, 2>> MotionFeatureExtractor::Update(
     auto velocities = [&](int frames, Eigen::Vector3d* elbow, Eigen::Vector3d* wrist) {
       const ArmSample& before = h[h.size() - 1 - std::min<size_t>(frames, h.size() - 1)];
       const double dt = s.t - before.t;
-      *elbow = dt > 0 ? Eigen::Vector3d((s.elbow - before.elbow) / dt) : Eigen::Vector3d::Zero();
-      *wrist = dt > 0 ? Eigen::Vector3d((s.wrist - before.wrist) / dt) : Eigen::Vector3d::Zero();
+      *elbow = dt > 0 ? Eigen::Vector3d(to_body * (s.elbow - before.elbow) / dt) : Eigen::Vector3d::Zero();
+      *wrist = dt > 0 ? Eigen::Vector3d(to_body * (s.wrist - before.wrist) / dt) : Eigen::Vector3d::Zero();
     };
     Eigen::Vector3d v_elbow, v_wrist, v_elbow_long, v_wrist_long;
     velocities(kVelocityFrames, &v_elbow, &v_wrist);
     velocities(kLongVelocityFrames, &v_elbow_long, &v_wrist_long);
     MotionFeatures& f = out[a];
-    PutPosition(s.elbow, o.height_m, &f, 0);
-    PutPosition(s.wrist, o.height_m, &f, 5);
-    PutVelocity(s.elbow, v_elbow, &f, 10);
-    PutVelocity(s.wrist, v_wrist, &f, 17);
+    const Eigen::Vector3d elbow = to_body * s.elbow, wrist = to_body * s.wrist;
+    PutPosition(elbow, o.height_m, &f, 0);
+    PutPosition(wrist, o.height_m, &f, 5);
+    PutVelocity(elbow, v_elbow, &f, 10);
+    PutVelocity(wrist, v_wrist, &f, 17);
     const double long_speed = v_wrist_long.norm();
     f.segment<3>(24) = v_wrist_long / std::max(long_speed, kDirectionSpeed);
     f(27) = long_speed;

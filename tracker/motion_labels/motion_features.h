@@ -7,10 +7,12 @@
 //     cylindrical about the vertical through the shoulder (rho, theta with
 //     theta = atan2(x, y), 0 straight ahead);
 //   - velocities of the elbow and the wrist relative to the shoulder, m/s,
-//     over the last kVelocityFrames frames: the unit direction (Euclidean
-//     and cylindrical: d rho, rho d theta, dz) and the speed; the direction
-//     fades to 0 below kDirectionSpeed so that jitter at a pause gives no
-//     direction;
+//     over the last kVelocityFrames frames, as the truth's labels take them
+//     (sim/motion/labels.h): the change of the world shoulder-to-joint
+//     vector turned into the current upper-body frame, so the frame's own
+//     jitter is no motion; the unit direction (Euclidean and cylindrical:
+//     d rho, rho d theta, dz) and the speed; the direction fades to 0 below
+//     kDirectionSpeed so that jitter at a pause gives no direction;
 //   - the same over the last kLongVelocityFrames frames for the wrist
 //     (direction and speed) and the elbow (speed): the tracked joints jitter
 //     by a centimetre or two, which over 3 frames alone is a speed of
@@ -66,7 +68,7 @@ class MotionFeatureExtractor {
  private:
   struct ArmSample {
     double t;
-    Eigen::Vector3d elbow, wrist;  // shoulder-relative, upper-body frame, mirrored, metres
+    Eigen::Vector3d elbow, wrist;  // shoulder-relative, world frame, metres
   };
   std::array<std::deque<ArmSample>, 2> history_;
 };

@@ -75,6 +75,23 @@ TEST(MotionFeaturesTest, PositionsAndVelocitiesInTheShoulderFrame) {
   EXPECT_EQ(MotionFeatureNames()[23], "wrist_speed");
 }
 
+// A person turning at 1 rad/s, the arm still in the body: the shoulder-to-
+// wrist vector turns with the body, so the wrist moves (the truth's rule
+// takes the world vector's change), by the chord 2 r sin(dtheta / 2).
+TEST(MotionFeaturesTest, TurningWithTheBodyIsMotionOfTheWorldVector) {
+  MotionFeatureExtractor extractor;
+  std::optional<std::array<MotionFeatures, 2>> f;
+  for (int i = 0; i <= kVelocityFrames; ++i) f = extractor.Update(Person(i / 30.0, 1.0 * i / 30.0, {0.1, 0.3, -0.2}));
+  const double dt = kVelocityFrames / 30.0, r = std::hypot(0.1, 0.3);
+  EXPECT_NEAR((*f)[0](23), 2 * r * std::sin(1.0 * dt / 2) / dt, 1e-9);
+  EXPECT_NEAR((*f)[0](19), 0.0, 1e-9);  // no vertical part
+  // Turning left (counter-clockwise from above) moves a wrist in front of
+  // the right shoulder to the person's left: negative x, for both arms
+  // (the left arm mirrored: towards its outside).
+  EXPECT_LT((*f)[0](17), -0.5);
+  EXPECT_GT((*f)[1](17), 0.5);
+}
+
 // Slow moves give a speed but no direction; a gap restarts the history.
 TEST(MotionFeaturesTest, SlowMovesHaveNoDirectionAndGapsRestart) {
   MotionFeatureExtractor extractor;
