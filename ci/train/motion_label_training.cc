@@ -180,8 +180,8 @@ MotionLabelModel Fit(MotionModelKind kind, const std::vector<std::pair<std::vect
   return m;
 }
 
-void Evaluate(const MotionLabelModel& model, const TrackedLabels& s, Confusion* confusion) {
-  MotionLabeler labeler(std::make_shared<MotionLabelModel>(model));
+void Evaluate(const std::shared_ptr<const MotionLabelModel>& model, const TrackedLabels& s, Confusion* confusion) {
+  MotionLabeler labeler(model);
   std::vector<std::optional<std::array<std::string, 2>>> found(s.observations.size());
   auto put = [&](const std::vector<MotionLabeler::Labels>& labels) {
     for (const auto& l : labels) found[l.frame] = l.arms;
@@ -252,12 +252,12 @@ MotionLabelTrainingResult RunMotionLabelTraining(const MotionLabelTrainingJob& j
     const std::string name = MotionModelKindName(kind);
     const auto start = std::chrono::steady_clock::now();
     CrfTrainingReport report;
-    MotionLabelModel model = Fit(kind, chains, job, &report);
+    auto model = std::make_shared<MotionLabelModel>(Fit(kind, chains, job, &report));
     result.train_seconds[name] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.reports[name] = report;
-    model.provenance = Provenance(job, train, result.train_frames, rest_path, model, report);
+    model->provenance = Provenance(job, train, result.train_frames, rest_path, *model, report);
     const fs::path path = out_dir / ("motion_" + name + ".json");
-    model.Save(path);
+    model->Save(path);
     result.models.push_back(path);
     for (const TrackedLabels& s : test) Evaluate(model, s, &result.evaluation.confusion[name]);
   }

@@ -105,6 +105,12 @@ LiveReport RunLiveJob(const LiveJobOptions& options) {
   std::vector<double> latency_ms;
   std::string record;
   int last_frame = -1;
+  // Motion labels come the labeller's latency after their frame's bundle.
+  const auto publish_motion = [&](const std::vector<MotionLabeler::Labels>& labels) {
+    for (const MotionLabeler::Labels& l : labels) {
+      if (l.arms && !publisher.PublishMotion(l.frame, (*l.arms)[0], (*l.arms)[1])) ++report.send_failures;
+    }
+  };
   try {
     Progress progress("live", "frame-sets", frames);
     for (;;) {
@@ -126,9 +132,7 @@ LiveReport RunLiveJob(const LiveJobOptions& options) {
       const double dt = (last_frame < 0 ? 1 : f - last_frame) / input.fps();
       const FrameTracker::Step step = tracker.Track(f, std::move(images), problems, dt);
       if (!publisher.Publish(step.track_line, dropped)) ++report.send_failures;
-      for (const MotionLabeler::Labels& l : step.motion) {
-        if (l.arms && !publisher.PublishMotion(l.frame, (*l.arms)[0], (*l.arms)[1])) ++report.send_failures;
-      }
+      publish_motion(step.motion);
       latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - arrival).count());
       record += step.track_line.dump() + "\n";
       last_frame = f;
@@ -137,9 +141,7 @@ LiveReport RunLiveJob(const LiveJobOptions& options) {
     }
     // The motion labels of the last frames, which waited for frames that
     // will not come.
-    for (const MotionLabeler::Labels& l : tracker.FinishMotion()) {
-      if (l.arms && !publisher.PublishMotion(l.frame, (*l.arms)[0], (*l.arms)[1])) ++report.send_failures;
-    }
+    publish_motion(tracker.FinishMotion());
   } catch (...) {
     {
       std::lock_guard lock(box.mutex);

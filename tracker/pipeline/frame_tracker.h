@@ -72,7 +72,8 @@ class FrameTracker {
   const std::filesystem::path& posture_atoms_path() const { return posture_atoms_path_; }
   // The gesture models' file in use; empty when gesture recognition is off.
   const std::filesystem::path& gesture_models_path() const { return gesture_models_path_; }
-  // The motion-label model's file in use and its kind; empty when off.
+  // The motion-label model's file in use, and its labeller; empty / null
+  // when motion labelling is off.
   const std::filesystem::path& motion_labels_path() const { return motion_labels_path_; }
   const MotionLabeler* motion_labeler() const { return motion_labeler_ ? &*motion_labeler_ : nullptr; }
   const FrontEnd& front_end() const { return front_end_; }
