@@ -1,10 +1,15 @@
-# irbench_test(NAME SOURCES... LIBS ... [LABELS label]): a GoogleTest binary
-# registered with CTest. Its tests carry the CTest label "closed_loop" when it
-# is declared under tests/ (renders, the CLI, the tracker end to end) and "unit"
-# beside a library; `ctest -L unit` runs the latter (ci/sanitize.sh). LABELS
-# replaces that label (one label: gtest_discover_tests splits lists).
+# irbench_test(NAME SOURCES... LIBS ... [LABELS label] [COST seconds]
+#              [SHARED_RENDERS]): a GoogleTest binary registered with CTest. Its
+# tests carry the CTest label "closed_loop" when it is declared under tests/
+# (renders, the CLI, the tracker end to end) and "unit" beside a library;
+# `ctest -L unit` runs the latter (ci/sanitize.sh). LABELS replaces that label
+# (one label: gtest_discover_tests splits lists). COST: about how long its
+# longest test runs; `ctest -j` starts the costliest first, so a fresh build
+# directory (no CTestCostData.txt yet) does not end on a long test alone.
+# SHARED_RENDERS: its tests use tests/shared_render.h, whose renders CTest
+# clears before the first and after the last of them (fixture test_renders).
 function(irbench_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "SHARED_RENDERS" "COST" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT ARG_LABELS)
     file(RELATIVE_PATH rel_dir "${PROJECT_SOURCE_DIR}" "${CMAKE_CURRENT_SOURCE_DIR}")
     if(rel_dir STREQUAL "tests" OR rel_dir MATCHES "^tests/")
@@ -18,7 +23,22 @@ function(irbench_test name)
   target_compile_definitions(${name} PRIVATE
     IRBENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     IRBENCH_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}")
+  set(properties LABELS "${ARG_LABELS}")
+  if(ARG_COST)
+    list(APPEND properties COST ${ARG_COST})
+  endif()
+  if(ARG_SHARED_RENDERS)
+    list(APPEND properties FIXTURES_REQUIRED test_renders)
+    get_property(declared GLOBAL PROPERTY IRBENCH_TEST_RENDERS_FIXTURE)
+    if(NOT declared)
+      set_property(GLOBAL PROPERTY IRBENCH_TEST_RENDERS_FIXTURE ON)
+      add_test(NAME TestRenders.ClearBefore COMMAND ${CMAKE_COMMAND} -E rm -rf ${PROJECT_BINARY_DIR}/test-renders)
+      add_test(NAME TestRenders.ClearAfter COMMAND ${CMAKE_COMMAND} -E rm -rf ${PROJECT_BINARY_DIR}/test-renders)
+      set_tests_properties(TestRenders.ClearBefore PROPERTIES FIXTURES_SETUP test_renders)
+      set_tests_properties(TestRenders.ClearAfter PROPERTIES FIXTURES_CLEANUP test_renders)
+    endif()
+  endif()
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES ${properties})
   # `cmake --build <dir> --target irbench_unit_tests` builds the "unit" ones only.
   if(ARG_LABELS STREQUAL "unit")
     if(NOT TARGET irbench_unit_tests)

@@ -13,6 +13,7 @@
 
 #include "sim/sequence/camera_faults.h"
 #include "sim/sequence/render_job.h"
+#include "tests/shared_render.h"
 #include "tests/test_util.h"
 #include "tests/track_figures.h"
 #include "tracker/pipeline/track_job.h"
@@ -21,6 +22,7 @@ namespace irbench {
 namespace {
 namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
+using irbench::testing::SharedRender;
 using irbench::testing::WriteText;
 
 using irbench::testing::ReadJsonLines;
@@ -42,7 +44,7 @@ class CameraFaultTest : public ::testing::Test {
     options.supersample = 1;  // a quarter of the render time; the tracker sees the same kind of frames
     options.seed = 11;
     options.out = *dir_ / "seq";
-    seq_ = new fs::path(RunRenderJob(options));
+    seq_ = new fs::path(SharedRender("fault_session", options));
     truth_ = new std::vector<nlohmann::json>(ReadJsonLines(*seq_ / "truth/frames.jsonl"));
   }
   static void TearDownTestSuite() {

@@ -16,6 +16,7 @@
 
 #include "common/error.h"
 #include "sim/sequence/render_job.h"
+#include "tests/shared_render.h"
 #include "tests/test_util.h"
 #include "tests/track_figures.h"
 #include "tracker/live/live_job.h"
@@ -26,6 +27,7 @@ namespace irbench {
 namespace {
 namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
+using irbench::testing::SharedRender;
 using irbench::testing::ReadJsonLines;
 
 // What the receiver heard: per frame, its joints and rest state, in order.
@@ -95,7 +97,7 @@ class LiveTest : public ::testing::Test {
     options.supersample = 1;
     options.seed = 3;
     options.out = *dir_ / "seq";
-    seq_ = new fs::path(RunRenderJob(options));
+    seq_ = new fs::path(SharedRender("wave_p1", options));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sim/sequence/render_job.h"
+#include "tests/shared_render.h"
 #include "tests/test_util.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/io/sequence_input.h"
@@ -22,6 +23,7 @@ namespace irbench {
 namespace {
 namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
+using irbench::testing::SharedRender;
 using irbench::testing::WriteText;
 
 Eigen::Vector3d V(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
@@ -56,7 +58,7 @@ class PoseClosedLoopTest : public ::testing::Test {
     options.background_frames = 12;
     options.seed = 5;
     options.out = *dir_ / "seq";
-    seq_ = new fs::path(RunRenderJob(options));
+    seq_ = new fs::path(SharedRender("pose_session", options));
     std::ifstream in(*seq_ / "truth/frames.jsonl");
     truth_ = new std::vector<nlohmann::json>;
     for (std::string line; std::getline(in, line);) truth_->push_back(nlohmann::json::parse(line));

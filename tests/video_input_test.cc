@@ -16,6 +16,7 @@
 #include "common/error.h"
 #include "sim/sequence/render_job.h"
 #include "sim/sequence/render_resume.h"
+#include "tests/shared_render.h"
 #include "tests/test_util.h"
 #include "tests/track_figures.h"
 #include "tracker/io/sequence_input.h"
@@ -25,6 +26,7 @@ namespace irbench {
 namespace {
 namespace fs = std::filesystem;
 using irbench::testing::FreshTempDir;
+using irbench::testing::SharedRender;
 
 using irbench::testing::ReadJsonLines;
 
@@ -81,7 +83,7 @@ class VideoInputTest : public ::testing::Test {
     options.seed = 5;
     options.write_video = true;
     options.out = *dir_ / "seq";
-    seq_ = new fs::path(RunRenderJob(options));
+    seq_ = new fs::path(SharedRender("wave_p2_video", options));
     truth_ = new std::vector<nlohmann::json>(ReadJsonLines(*seq_ / "truth/frames.jsonl"));
   }
   static void TearDownTestSuite() {
