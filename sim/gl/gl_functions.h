@@ -66,13 +66,20 @@ namespace irbench {
   X(PFNGLUNIFORM1IPROC, Uniform1i)                                     \
   X(PFNGLUNIFORM1IVPROC, Uniform1iv)                                   \
   X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                   \
+  X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                   \
   X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                   \
   X(PFNGLDRAWELEMENTSPROC, DrawElements)                               \
   X(PFNGLFINISHPROC, Finish)                                           \
   X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                             \
   X(PFNGLTEXIMAGE3DPROC, TexImage3D)                                   \
   X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, FramebufferTextureLayer)       \
-  X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)
+  X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)                         \
+  X(PFNGLSTENCILFUNCPROC, StencilFunc)                                 \
+  X(PFNGLSTENCILOPPROC, StencilOp)                                     \
+  X(PFNGLSTENCILMASKPROC, StencilMask)                                 \
+  X(PFNGLDEPTHMASKPROC, DepthMask)                                     \
+  X(PFNGLCLEARBUFFERFIPROC, ClearBufferfi)                             \
+  X(PFNGLDRAWARRAYSPROC, DrawArrays)
 
 struct GlFunctions {
 #define IRBENCH_GL_MEMBER(type, name) type name = nullptr;

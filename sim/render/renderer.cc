@@ -7,186 +7,17 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.h"
+#include "sim/render/shaders.h"
 
 namespace irbench {
 namespace {
 
-constexpr const char* kVertexShader = R"(#version 330 core
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_material;  // albedo (850 nm), emissive
-layout(location = 3) in vec2 a_extra;     // albedo at 940 nm (< 0: as 850), content emission
-uniform mat4 u_clip_from_world;
-uniform mat4 u_cam_from_world;
-uniform vec3 u_camera_center;
-// Bounce light (sim/lighting/bounce.h): irradiance onto +x, -x, +y, -y, +z, -z
-// facing surfaces, channels 850 nm / 940 nm / screen content. It varies
-// slowly, so it is read per vertex (static meshes are cut to short edges).
-uniform sampler3D u_bounce[6];
-uniform int u_bounce_on;
-uniform vec3 u_bounce_origin;
-uniform float u_bounce_spacing;
-uniform vec3 u_bounce_dims;
-out vec3 v_world;
-out vec3 v_normal;
-out vec2 v_material;
-out vec2 v_extra;
-out vec3 v_bounce;
-out float v_depth;
-
-vec3 Bounce(vec3 p, vec3 n) {
-  vec3 uvw = ((p - u_bounce_origin) / u_bounce_spacing + 0.5) / u_bounce_dims;
-  vec3 n2 = n * n;
-  vec3 ex = n.x >= 0.0 ? textureLod(u_bounce[0], uvw, 0.0).rgb : textureLod(u_bounce[1], uvw, 0.0).rgb;
-  vec3 ey = n.y >= 0.0 ? textureLod(u_bounce[2], uvw, 0.0).rgb : textureLod(u_bounce[3], uvw, 0.0).rgb;
-  vec3 ez = n.z >= 0.0 ? textureLod(u_bounce[4], uvw, 0.0).rgb : textureLod(u_bounce[5], uvw, 0.0).rgb;
-  return n2.x * ex + n2.y * ey + n2.z * ez;
-}
-
-void main() {
-  vec4 p = vec4(a_position, 1.0);
-  gl_Position = u_clip_from_world * p;
-  v_world = a_position;
-  v_normal = a_normal;
-  v_material = a_material;
-  v_extra = a_extra;
-  v_bounce = vec3(0.0);
-  if (u_bounce_on != 0) {
-    // Two-sided: the side the camera sees.
-    vec3 n = normalize(a_normal);
-    if (dot(n, u_camera_center - a_position) < 0.0) n = -n;
-    v_bounce = Bounce(a_position, n);
-  }
-  v_depth = (u_cam_from_world * p).z;
-}
-)";
-
-constexpr const char* kFragmentShader = R"(
-in vec3 v_world;
-in vec3 v_normal;
-in vec2 v_material;
-in vec2 v_extra;
-in vec3 v_bounce;
-in float v_depth;
-uniform float u_person;
-uniform vec3 u_camera_center;
-uniform float u_ambient;
-uniform int u_light_count;
-uniform vec3 u_light_position[8];
-uniform vec3 u_light_direction[8];
-uniform float u_light_cos_half[8];
-uniform float u_light_power[8];
-uniform int u_light_band[8];  // 0: 850 nm, 1: 940 nm
-uniform int u_light_shadow_slot[8];  // -1: no shadow map
-uniform sampler2DArray u_shadow_maps;  // one layer per shadow slot
-uniform mat4 u_shadow_clip_from_world[4];
-uniform mat4 u_shadow_cam_from_world[4];
-uniform float u_shadow_size_uv[4];  // light side / (2 tan(fov / 2))
-uniform float u_shadow_texel[4];    // one texel in uv
-layout(location = 0) out vec4 o_radiance;  // 850 nm, 940 nm, content, emission
-layout(location = 1) out float o_mask;
-layout(location = 2) out float o_depth;
-
-#if SHADOWS
-float ShadowDepth(int slot, vec2 uv) { return texture(u_shadow_maps, vec3(uv, float(slot))).r; }
-
-// Percentage-closer soft shadows for a square light: average the blockers'
-// depth over the light's visibility pyramid, then filter over the pyramid's
-// cross-section at that depth, so the penumbra grows as size * (z_r - z_b) / z_b.
-// Depth comparisons follow the receiver's plane (its depth gradient in uv), so
-// wide kernels do not shadow the receiver itself.
-float Visibility(int slot, vec3 p, int search_count) {
-  vec4 clip = u_shadow_clip_from_world[slot] * vec4(p, 1.0);
-  if (clip.w <= 0.0) return 1.0;
-  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-  float z_r = (u_shadow_cam_from_world[slot] * vec4(p, 1.0)).z;
-  vec3 dx = dFdx(vec3(uv, z_r));
-  vec3 dy = dFdy(vec3(uv, z_r));
-  float det = dx.x * dy.y - dx.y * dy.x;
-  vec2 dz_duv = abs(det) > 1e-12
-      ? vec2(dy.y * dx.z - dx.y * dy.z, dx.x * dy.z - dy.x * dx.z) / det
-      : vec2(0.0);
-  dz_duv = clamp(dz_duv, vec2(-50.0 * z_r), vec2(50.0 * z_r));
-  float texel = u_shadow_texel[slot];
-  float bias = 0.01 + 0.004 * z_r;
-  float size = u_shadow_size_uv[slot];
-  float search = max(3.0 * size / z_r, 2.0 * texel);
-  float blockers = 0.0;
-  float depth_sum = 0.0;
-  for (int i = 0; i < search_count; ++i) {
-      vec2 o = (vec2(i / 3, i % 3) / 2.0 - 0.5) * search;
-      float d = ShadowDepth(slot, uv + o);
-      if (d < z_r + dot(dz_duv, o) - bias) {
-        depth_sum += d;
-        blockers += 1.0;
-      }
-  }
-  if (blockers == 0.0) return 1.0;
-  float z_b = depth_sum / blockers;
-  float width = max(size * (z_r - z_b) / (z_r * z_b), texel);
-  float lit = 0.0;
-  int count = blockers > 0.0 ? 25 : 0;
-  for (int i = 0; i < count; ++i) {
-      vec2 o = ((vec2(i / 5, i % 5) + 0.5) / 5.0 - 0.5) * width;
-      lit += ShadowDepth(slot, uv + o) < z_r + dot(dz_duv, o) - bias ? 0.0 : 1.0;
-  }
-  return lit / 25.0;
-}
-#endif
-
-void main() {
-  vec3 n = normalize(v_normal);
-  if (dot(n, u_camera_center - v_world) < 0.0) n = -n;  // two-sided
-  vec4 radiance = vec4(0.0);
-  if (v_material.y > 0.5) {
-    radiance.a = v_material.x;
-  } else {
-    // Irradiance per channel: illuminators at 850 and 940 nm, screen content.
-    vec3 irradiance = vec3(u_ambient, 0.0, 0.0) + v_bounce;
-    for (int i = 0; i < u_light_count; ++i) {
-      vec3 to_light = u_light_position[i] - v_world;
-      float d2 = max(dot(to_light, to_light), 0.25);
-      vec3 l = to_light * inversesqrt(dot(to_light, to_light));
-      float c = dot(-l, u_light_direction[i]);
-      float cone = smoothstep(u_light_cos_half[i] - 0.05, u_light_cos_half[i] + 0.05, c);
-      float lambert = max(dot(n, l), 0.0);
-      float vis = 1.0;
-      int slot = u_light_shadow_slot[i];
-#if SHADOWS
-      if (slot >= 0) vis = Visibility(slot, v_world, cone * lambert > 0.0 ? 9 : 0);
-#endif
-      float e = u_light_power[i] * cone * lambert * vis / d2;
-      if (u_light_band[i] == 0) irradiance.x += e; else irradiance.y += e;
-    }
-    float r850 = v_material.x;
-    float r940 = v_extra.x < 0.0 ? r850 : v_extra.x;
-    radiance.rgb = vec3(r850, r940, 0.5 * (r850 + r940)) * irradiance;
-    radiance.b += v_extra.y;
-  }
-  o_radiance = radiance;
-  o_mask = u_person;
-  o_depth = v_depth;
-}
-)";
-
-// Shadow maps: camera-frame z of the nearest surface seen from the light.
-constexpr const char* kShadowVertexShader = R"(#version 330 core
-layout(location = 0) in vec3 a_position;
-uniform mat4 u_clip_from_world;
-uniform mat4 u_cam_from_world;
-out float v_z;
-void main() {
-  vec4 p = vec4(a_position, 1.0);
-  gl_Position = u_clip_from_world * p;
-  v_z = (u_cam_from_world * p).z;
-}
-)";
-
-constexpr const char* kShadowFragmentShader = R"(#version 330 core
-in float v_z;
-layout(location = 0) out float o_z;
-void main() { o_z = v_z; }
-)";
+using shaders::kFragmentShader;
+using shaders::kMarkFragmentShader;
+using shaders::kMarkVertexShader;
+using shaders::kShadowFragmentShader;
+using shaders::kShadowVertexShader;
+using shaders::kVertexShader;
 
 unsigned CompileShader(const GlFunctions& gl, GLenum type, const char* source) {
   const unsigned shader = gl.CreateShader(type);
@@ -269,6 +100,11 @@ struct Renderer::ShadowMap {
 struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
+  // The static scene alone, drawn once (UpdateStaticCache): what fbo's three
+  // images and its depth hold before the person is drawn, and per pixel the
+  // surface's world point and its shadow taps' reach (MarkShadowedPixels).
+  unsigned cache_fbo = 0, cache_depth_rbo = 0;
+  unsigned cache_tex[4] = {0, 0, 0, 0};  // radiance, mask, depth, world point and reach
   cv::Mat map_x, map_y;  // output pixel -> render pixel
   cv::Mat raw_half, raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
   Eigen::Matrix4f clip_from_world;
@@ -284,6 +120,8 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
                                (options_.shadows ? "1" : "0") + "\n" + kFragmentShader;
   program_ = LinkProgram(gl, kVertexShader, fragment.c_str());
   shadow_program_ = LinkProgram(gl, kShadowVertexShader, kShadowFragmentShader);
+  mark_program_ = LinkProgram(gl, kMarkVertexShader, kMarkFragmentShader);
+  gl.GenVertexArrays(1, &mark_vao_);  // the mark pass's full-screen triangle has no attributes
   gl.UseProgram(program_);
   SetLighting({}, 1.0);
   SetBounce(IrradianceVolume{});
@@ -350,15 +188,33 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
     make_texture(&target->grey_tex, GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT, GL_COLOR_ATTACHMENT0);
     make_texture(&target->mask_tex, GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT1);
     make_texture(&target->depth_tex, GL_R32F, GL_RED, GL_FLOAT, GL_COLOR_ATTACHMENT2);
-    gl.GenRenderbuffers(1, &target->depth_rbo);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, target->depth_rbo);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, rc.width, rc.height);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                               target->depth_rbo);
+    // Depth and stencil (the stencil marks the static pixels to shade again).
+    const auto make_depth = [&](unsigned* rbo) {
+      gl.GenRenderbuffers(1, rbo);
+      gl.BindRenderbuffer(GL_RENDERBUFFER, *rbo);
+      gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, rc.width, rc.height);
+      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, *rbo);
+    };
+    make_depth(&target->depth_rbo);
     const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     gl.DrawBuffers(3, buffers);
     if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       throw RuntimeError("framebuffer incomplete for camera " + cam.name);
+    }
+    if (options_.static_cache) {
+      gl.GenFramebuffers(1, &target->cache_fbo);
+      gl.BindFramebuffer(GL_FRAMEBUFFER, target->cache_fbo);
+      make_texture(&target->cache_tex[0], GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT, GL_COLOR_ATTACHMENT0);
+      make_texture(&target->cache_tex[1], GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT1);
+      make_texture(&target->cache_tex[2], GL_R32F, GL_RED, GL_FLOAT, GL_COLOR_ATTACHMENT2);
+      make_texture(&target->cache_tex[3], GL_RGBA32F, GL_RGBA, GL_FLOAT, GL_COLOR_ATTACHMENT3);
+      make_depth(&target->cache_depth_rbo);
+      const GLenum cache_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                      GL_COLOR_ATTACHMENT3};
+      gl.DrawBuffers(4, cache_buffers);
+      if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        throw RuntimeError("static cache framebuffer incomplete for camera " + cam.name);
+      }
     }
     target->raw_half.create(rc.height, rc.width, CV_16FC4);
     target->raw_mask.create(rc.height, rc.width, CV_8UC1);
@@ -389,6 +245,11 @@ Renderer::~Renderer() {
     gl.DeleteTextures(1, &t->mask_tex);
     gl.DeleteTextures(1, &t->depth_tex);
     gl.DeleteRenderbuffers(1, &t->depth_rbo);
+    if (t->cache_fbo != 0) {
+      gl.DeleteFramebuffers(1, &t->cache_fbo);
+      gl.DeleteTextures(4, t->cache_tex);
+      gl.DeleteRenderbuffers(1, &t->cache_depth_rbo);
+    }
   }
   for (unsigned* b : {&static_vbo_, &static_ibo_, &person_vbo_, &person_ibo_}) gl.DeleteBuffers(1, b);
   if (bounce_textures_[0] != 0) gl.DeleteTextures(6, bounce_textures_);
@@ -404,6 +265,8 @@ Renderer::~Renderer() {
   gl.DeleteVertexArrays(1, &person_vao_);
   gl.DeleteProgram(program_);
   gl.DeleteProgram(shadow_program_);
+  gl.DeleteProgram(mark_program_);
+  gl.DeleteVertexArrays(1, &mark_vao_);
 }
 
 const Camera& Renderer::RenderCamera(int index) const { return targets_.at(index)->render_camera; }
@@ -451,6 +314,7 @@ void Renderer::SetBounce(const IrradianceVolume& volume) {
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_bounce_origin"), 1, origin.data());
   gl.Uniform1f(gl.GetUniformLocation(program_, "u_bounce_spacing"), static_cast<float>(volume.spacing));
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_bounce_dims"), 1, dims.data());
+  static_cache_dirty_ = true;
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while uploading the bounce light");
 }
 
@@ -516,6 +380,7 @@ void Renderer::SetStaticMesh(const TriangleMesh& input) {
   gl.BindVertexArray(0);
   shadows_dirty_ = true;
   static_shadows_dirty_ = true;
+  static_cache_dirty_ = true;
 }
 
 void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
@@ -620,8 +485,18 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   gl.Uniform1i(gl.GetUniformLocation(program_, "u_shadow_maps"), 1);
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_size_uv"), 4, size_uv.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_texel"), 4, texel.data());
+  gl.UseProgram(mark_program_);
+  gl.Uniform1i(gl.GetUniformLocation(mark_program_, "u_slot_count"), static_cast<int>(shadow_maps_.size()));
+  for (int k = 0; k < 4; ++k) {
+    const std::string index = "[" + std::to_string(k) + "]";
+    gl.UniformMatrix4fv(gl.GetUniformLocation(mark_program_, ("u_shadow_clip_from_world" + index).c_str()), 1,
+                        GL_FALSE, shadow_clip[k].data());
+  }
+  gl.Uniform1fv(gl.GetUniformLocation(mark_program_, "u_shadow_texel"), 4, texel.data());
+  gl.Uniform1i(gl.GetUniformLocation(mark_program_, "u_static_world"), 8);
   shadows_dirty_ = true;
   static_shadows_dirty_ = true;
+  static_cache_dirty_ = true;
 }
 
 void Renderer::DrawPerson(int person_flag_location) {
@@ -684,7 +559,53 @@ void Renderer::UpdateShadows() {
     DrawPerson(-1);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  // The person's extent in each shadow map, for the static visibility: all of
+  // it when a vertex lies behind the light, none when nobody is drawn.
+  std::vector<Eigen::Vector4f> boxes(4, Eigen::Vector4f(2, 2, -2, -2));
+  const bool person_drawn = person_visible_ && person_index_count_ > 0;
+  for (size_t k = 0; k < shadow_maps_.size() && person_drawn; ++k) {
+    Eigen::Vector4f& box = boxes[k];
+    if (person_positions_.size() != person_vertex_count_) box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
+    for (const Eigen::Vector3f& p : person_positions_) {
+      const Eigen::Vector4f clip = shadow_maps_[k]->clip_from_world * p.homogeneous();
+      if (!(clip.w() > 1e-6f)) {
+        box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
+        break;
+      }
+      const float u = clip.x() / clip.w() * 0.5f + 0.5f, v = clip.y() / clip.w() * 0.5f + 0.5f;
+      box = Eigen::Vector4f(std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v));
+    }
+  }
+  gl.UseProgram(mark_program_);
+  gl.Uniform4fv(gl.GetUniformLocation(mark_program_, "u_person_box"), 4, boxes[0].data());
   shadows_dirty_ = false;
+}
+
+void Renderer::UpdateStaticCache() {
+  if (!options_.static_cache || !static_cache_dirty_) return;
+  // The static scene alone, shaded with the static shadow maps. The scene and
+  // its lights do not move: a static pixel the person neither covers nor
+  // shadows (no shadow tap near the person's texels) comes out the same in
+  // every frame.
+  const GlFunctions& gl = gl_;
+  if (!shadow_maps_.empty()) {
+    gl.ActiveTexture(GL_TEXTURE1);
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, static_shadow_array_);
+    gl.ActiveTexture(GL_TEXTURE0);
+  }
+  const float zero[4] = {0, 0, 0, 0};
+  const float no_surface[4] = {0, 0, 0, -1};
+  for (const auto& target : targets_) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, target->cache_fbo);
+    BeginCameraPass(*target);
+    for (int i = 0; i < 3; ++i) gl.ClearBufferfv(GL_COLOR, i, zero);
+    gl.ClearBufferfv(GL_COLOR, 3, no_surface);
+    gl.ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    DrawStatic(gl.GetUniformLocation(program_, "u_person"));
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while drawing the static scene's cache");
+  static_cache_dirty_ = false;
 }
 
 void Renderer::SetPersonTopology(const std::vector<uint32_t>& indices, size_t vertex_count) {
@@ -706,11 +627,14 @@ void Renderer::UpdatePerson(const std::vector<MeshVertex>& vertices) {
   const GlFunctions& gl = gl_;
   gl.BindBuffer(GL_ARRAY_BUFFER, person_vbo_);
   gl.BufferSubData(GL_ARRAY_BUFFER, 0, vertices.size() * sizeof(MeshVertex), vertices.data());
+  person_positions_.resize(vertices.size());
+  for (size_t i = 0; i < vertices.size(); ++i) person_positions_[i] = vertices[i].position;
   shadows_dirty_ = true;
 }
 
 void Renderer::Render(int index, CameraImages* out, bool want_depth) {
   UpdateShadows();
+  UpdateStaticCache();
   Draw(index);
   ReadBack(index);
   Resample(index, out, want_depth);
@@ -732,6 +656,7 @@ void Renderer::RenderAll(std::vector<CameraImages>* out, bool want_depth) {
   out->resize(targets_.size());
   const Clock::time_point start = Clock::now();
   UpdateShadows();
+  UpdateStaticCache();
   for (size_t i = 0; i < targets_.size(); ++i) Draw(static_cast<int>(i));
   const Clock::time_point drawn = Clock::now();
   std::vector<std::future<void>> resampled;
@@ -750,18 +675,12 @@ void Renderer::RenderAll(std::vector<CameraImages>* out, bool want_depth) {
   ++stage_times_.frame_sets;
 }
 
-void Renderer::Draw(int index) {
+void Renderer::BeginCameraPass(const Target& t) {
   const GlFunctions& gl = gl_;
-  Target& t = *targets_.at(index);
   const Camera& rc = t.render_camera;
-  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl.Viewport(0, 0, rc.width, rc.height);
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(GL_LESS);
-  const float zero[4] = {0, 0, 0, 0};
-  const float one = 1.0f;
-  for (int i = 0; i < 3; ++i) gl.ClearBufferfv(GL_COLOR, i, zero);
-  gl.ClearBufferfv(GL_DEPTH, 0, &one);
   gl.UseProgram(program_);
   gl.UniformMatrix4fv(gl.GetUniformLocation(program_, "u_clip_from_world"), 1, GL_FALSE,
                       t.clip_from_world.data());
@@ -770,16 +689,107 @@ void Renderer::Draw(int index) {
                       cam_from_world.data());
   const Eigen::Vector3f center = rc.CenterInWorld().cast<float>();
   gl.Uniform3fv(gl.GetUniformLocation(program_, "u_camera_center"), 1, center.data());
+}
+
+void Renderer::Draw(int index) {
+  const GlFunctions& gl = gl_;
+  Target& t = *targets_.at(index);
   if (shadow_array_ != 0) {
     gl.ActiveTexture(GL_TEXTURE1);
     gl.BindTexture(GL_TEXTURE_2D_ARRAY, shadow_array_);
     gl.ActiveTexture(GL_TEXTURE0);
   }
-  // Near to far: the person, then the scene (rooms last), for early depth
-  // rejection.
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  if (t.cache_fbo == 0) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+    BeginCameraPass(t);
+    const float zero[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 3; ++i) gl.ClearBufferfv(GL_COLOR, i, zero);
+    gl.ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    // Near to far: the person, then the scene (rooms last), for early depth
+    // rejection.
+    const int person_flag = gl.GetUniformLocation(program_, "u_person");
+    DrawPerson(person_flag);
+    DrawStatic(person_flag);
+    return;
+  }
+  // The static scene's images and depth, then the person over them.
+  const Camera& rc = t.render_camera;
+  gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.cache_fbo);
+  gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, t.fbo);
+  for (int i = 0; i < 3; ++i) {
+    GLenum one_buffer[] = {GL_NONE, GL_NONE, GL_NONE};
+    one_buffer[i] = buffers[i];
+    gl.ReadBuffer(buffers[i]);
+    gl.DrawBuffers(3, one_buffer);
+    gl.BlitFramebuffer(0, 0, rc.width, rc.height, 0, 0, rc.width, rc.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  gl.BlitFramebuffer(0, 0, rc.width, rc.height, 0, 0, rc.width, rc.height,
+                     GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT, GL_NEAREST);
+  gl.DrawBuffers(3, buffers);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  BeginCameraPass(t);
+  if (!person_visible_ || person_index_count_ == 0) return;
+  // As when the person is drawn first and the scene after it, both with a
+  // LESS test: the person's nearest depth wins ties with the scene (a depth
+  // pass, LEQUAL, stencil 2 where the person is), then the first of its
+  // fragments at that depth is shaded (EQUAL, stencil 2 -> 3).
   const int person_flag = gl.GetUniformLocation(program_, "u_person");
+  gl.Enable(GL_STENCIL_TEST);
+  gl.StencilMask(0xFF);
+  const GLenum none[] = {GL_NONE};
+  gl.DrawBuffers(1, none);
+  gl.DepthFunc(GL_LEQUAL);
+  gl.StencilFunc(GL_ALWAYS, 2, 0xFF);
+  gl.StencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  // Depth only: the shadow maps' program, whose vertex positions are the same
+  // expression of the same matrix (the shading is not paid twice).
+  gl.UseProgram(shadow_program_);
+  gl.UniformMatrix4fv(gl.GetUniformLocation(shadow_program_, "u_clip_from_world"), 1, GL_FALSE,
+                      t.clip_from_world.data());
+  DrawPerson(-1);
+  gl.UseProgram(program_);
+  gl.DrawBuffers(3, buffers);
+  gl.DepthFunc(GL_EQUAL);
+  gl.DepthMask(GL_FALSE);
+  gl.StencilFunc(GL_EQUAL, 2, 0xFF);
+  gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR);
   DrawPerson(person_flag);
-  DrawStatic(person_flag);
+  gl.DepthMask(GL_TRUE);
+  gl.DepthFunc(GL_LESS);
+  if (!shadow_maps_.empty()) ShadeShadowedPixels(t);
+  gl.Disable(GL_STENCIL_TEST);
+}
+
+void Renderer::ShadeShadowedPixels(const Target& t) {
+  // Stencil 0 -> 1 on the static pixels (not the person's) whose shadow taps
+  // may read the person's texels (the mark pass writes no colour), then the
+  // static scene drawn again where it is the surface seen (equal depth) and
+  // marked: the first fragment at that depth, as in a full draw (1 -> 2).
+  const GlFunctions& gl = gl_;
+  gl.StencilFunc(GL_EQUAL, 0, 0xFF);
+  gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+  gl.Disable(GL_DEPTH_TEST);
+  const GLenum none[] = {GL_NONE};
+  gl.DrawBuffers(1, none);
+  gl.UseProgram(mark_program_);
+  gl.ActiveTexture(GL_TEXTURE8);
+  gl.BindTexture(GL_TEXTURE_2D, t.cache_tex[3]);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindVertexArray(mark_vao_);
+  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl.BindVertexArray(0);
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  gl.DrawBuffers(3, buffers);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_EQUAL);
+  gl.DepthMask(GL_FALSE);
+  gl.StencilFunc(GL_EQUAL, 1, 0xFF);
+  gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+  gl.UseProgram(program_);
+  DrawStatic(gl.GetUniformLocation(program_, "u_person"));
+  gl.DepthMask(GL_TRUE);
+  gl.DepthFunc(GL_LESS);
 }
 
 void Renderer::ReadBack(int index) {

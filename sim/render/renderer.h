@@ -26,6 +26,10 @@ struct RenderOptions {
   // penumbrae from each light's size (percentage-closer soft shadows).
   bool shadows = false;
   int shadow_map_size = 1024;
+  // The static scene drawn once per camera and copied under the person each
+  // frame; only the static pixels the person's shadows may change are shaded
+  // again. The same pixels as without (off: everything drawn every frame).
+  bool static_cache = true;
   // The bounce light is read per vertex (it varies slowly); static meshes are
   // cut into triangles no longer than this for it. Finer costs llvmpipe more
   // partly covered pixel blocks than it gains.
@@ -107,6 +111,9 @@ class Renderer {
   struct Target;
   struct ShadowMap;
   void UpdateShadows();
+  void UpdateStaticCache();
+  void BeginCameraPass(const Target& t);
+  void ShadeShadowedPixels(const Target& t);
   void DrawPerson(int person_flag_location);
   void DrawStatic(int person_flag_location);
   void Draw(int index);
@@ -129,6 +136,9 @@ class Renderer {
   // starts from a copy of them and draws the person only.
   unsigned static_shadow_array_ = 0;
   bool static_shadows_dirty_ = true;
+  bool static_cache_dirty_ = true;
+  unsigned mark_program_ = 0, mark_vao_ = 0;
+  std::vector<Eigen::Vector3f> person_positions_;  // the last UpdatePerson's
   unsigned bounce_textures_[6] = {0, 0, 0, 0, 0, 0};  // GL_TEXTURE_3D, one per axis direction
   bool shadows_dirty_ = true;
   unsigned static_vao_ = 0, static_vbo_ = 0, static_ibo_ = 0;

@@ -213,6 +213,53 @@ double MeasurePenumbra(GlContext& context, double light_size, double* predicted)
   return (crossing(0.9) - crossing(0.1)) / 0.8;
 }
 
+// The static scene drawn once and copied under the person (the default) gives
+// the pixels of drawing everything every frame, bit for bit, while the
+// person's soft shadows move over the stage: a sphere walks across the
+// theater's stage lit by its three shadowing lights, seen by the four cameras.
+TEST(StaticCacheTest, SamePixelsAsDrawingEverythingEveryFrame) {
+  auto context = CreateGlContext(GlBackend::kAuto);
+  const Rig rig = LoadRig(std::string(IRBENCH_SOURCE_DIR) + "/rigs/theater4.json");
+  const Scene scene = LoadScene(std::string(IRBENCH_SOURCE_DIR) + "/scenes/theater.json");
+  RenderOptions cached_options;
+  cached_options.shadows = true;
+  RenderOptions full_options = cached_options;
+  full_options.static_cache = false;
+  Renderer cached(*context, rig.cameras, cached_options), full(*context, rig.cameras, full_options);
+  TriangleMesh body;
+  AppendSphere(body, Eigen::Vector3d::Zero(), 0.3, Material{0.6f, 0.0f}, 48, 24);
+  AppendBox(body, {-0.15, -0.1, -1.2}, {0.15, 0.1, -0.3}, Material{0.5f, 0.0f}, false);
+  std::vector<CameraImages> empty;
+  for (Renderer* r : {&cached, &full}) {
+    r->SetScene(scene);
+    r->SetPersonTopology(body.indices, body.vertices.size());
+  }
+  full.SetPersonVisible(false);
+  full.RenderAll(&empty, true);
+  full.SetPersonVisible(true);
+  int shadowed_pixels = 0;
+  for (const Eigen::Vector3d& at : {Eigen::Vector3d(-0.8, 0.4, 1.5), Eigen::Vector3d(0.0, 0.0, 1.5),
+                                    Eigen::Vector3d(0.9, -0.5, 1.4)}) {
+    TriangleMesh moved = body;
+    for (MeshVertex& v : moved.vertices) v.position += at.cast<float>();
+    std::vector<CameraImages> a, b;
+    for (Renderer* r : {&cached, &full}) r->UpdatePerson(moved.vertices);
+    cached.RenderAll(&a, true);
+    full.RenderAll(&b, true);
+    for (size_t c = 0; c < a.size(); ++c) {
+      EXPECT_EQ(cv::norm(a[c].radiance, b[c].radiance, cv::NORM_INF), 0.0) << rig.cameras[c].name;
+      EXPECT_EQ(cv::norm(a[c].mask, b[c].mask, cv::NORM_INF), 0.0) << rig.cameras[c].name;
+      EXPECT_EQ(cv::norm(a[c].depth, b[c].depth, cv::NORM_INF), 0.0) << rig.cameras[c].name;
+      // Darker than the empty stage off the person: its shadow.
+      cv::Mat darker;
+      cv::compare(b[c].grey + 3, empty[c].grey, darker, cv::CMP_LT);
+      darker.setTo(0, b[c].mask);
+      shadowed_pixels += cv::countNonZero(darker);
+    }
+  }
+  EXPECT_GT(shadowed_pixels, 2000) << "the person's shadows on the stage";
+}
+
 TEST(ShadowTest, PenumbraWidthFollowsTheLightSize) {
   auto context = CreateGlContext(GlBackend::kAuto);
   double predicted = 0;
