@@ -135,6 +135,10 @@ Command AddBenchRender(CLI::App* bench_cmd) {
   cmd->add_option("--frames", args->frames, "timed frame-sets per resolution")
       ->capture_default_str()
       ->transform(IntegerIn(1, 100000));
+  cmd->add_option_function<std::string>(
+         "--static-cache", [args](const std::string& v) { args->render.static_cache = v == "on"; },
+         "the static scene drawn once per camera and reused (the same pixels): on (default) or off, to compare")
+      ->check(CLI::IsMember({"on", "off"}));
   return {cmd, [args] { return RunBenchRender(*args); }};
 }
 

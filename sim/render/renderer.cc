@@ -12,6 +12,8 @@
 namespace irbench {
 namespace {
 
+constexpr int kTile = 8;  // pixels per side of the static cache's tiles
+
 using shaders::kFragmentShader;
 using shaders::kMarkFragmentShader;
 using shaders::kMarkVertexShader;
@@ -104,7 +106,16 @@ struct Renderer::Target {
   // images and its depth hold before the person is drawn, and per pixel the
   // surface's world point and its shadow taps' reach (MarkShadowedPixels).
   unsigned cache_fbo = 0, cache_depth_rbo = 0;
-  unsigned cache_tex[4] = {0, 0, 0, 0};  // radiance, mask, depth, world point and reach
+  // radiance, mask, depth, world point and reach, blocker depth per slot
+  unsigned cache_tex[5] = {0, 0, 0, 0, 0};
+  // Per tile of kTile x kTile pixels of the cache (row-major): per shadow slot
+  // the uv extent of its static surfaces (min u, min v, max u, max v; empty
+  // when min > max), how far their taps read beyond it, and the largest depth
+  // a tap compares with per slot.
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<std::array<Eigen::Vector4f, 4>> tile_uv;
+  std::vector<float> tile_reach;
+  std::vector<Eigen::Vector4f> tile_blocker_depth;
   cv::Mat map_x, map_y;  // output pixel -> render pixel
   cv::Mat raw_half, raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
   Eigen::Matrix4f clip_from_world;
@@ -121,7 +132,13 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
   program_ = LinkProgram(gl, kVertexShader, fragment.c_str());
   shadow_program_ = LinkProgram(gl, kShadowVertexShader, kShadowFragmentShader);
   mark_program_ = LinkProgram(gl, kMarkVertexShader, kMarkFragmentShader);
-  gl.GenVertexArrays(1, &mark_vao_);  // the mark pass's full-screen triangle has no attributes
+  gl.GenVertexArrays(1, &mark_vao_);
+  gl.BindVertexArray(mark_vao_);
+  gl.GenBuffers(1, &mark_vbo_);
+  gl.BindBuffer(GL_ARRAY_BUFFER, mark_vbo_);
+  gl.EnableVertexAttribArray(0);
+  gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+  gl.BindVertexArray(0);
   gl.UseProgram(program_);
   SetLighting({}, 1.0);
   SetBounce(IrradianceVolume{});
@@ -208,10 +225,11 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
       make_texture(&target->cache_tex[1], GL_R8, GL_RED, GL_UNSIGNED_BYTE, GL_COLOR_ATTACHMENT1);
       make_texture(&target->cache_tex[2], GL_R32F, GL_RED, GL_FLOAT, GL_COLOR_ATTACHMENT2);
       make_texture(&target->cache_tex[3], GL_RGBA32F, GL_RGBA, GL_FLOAT, GL_COLOR_ATTACHMENT3);
+      make_texture(&target->cache_tex[4], GL_RGBA32F, GL_RGBA, GL_FLOAT, GL_COLOR_ATTACHMENT4);
       make_depth(&target->cache_depth_rbo);
       const GLenum cache_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                                      GL_COLOR_ATTACHMENT3};
-      gl.DrawBuffers(4, cache_buffers);
+                                      GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+      gl.DrawBuffers(5, cache_buffers);
       if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         throw RuntimeError("static cache framebuffer incomplete for camera " + cam.name);
       }
@@ -247,7 +265,7 @@ Renderer::~Renderer() {
     gl.DeleteRenderbuffers(1, &t->depth_rbo);
     if (t->cache_fbo != 0) {
       gl.DeleteFramebuffers(1, &t->cache_fbo);
-      gl.DeleteTextures(4, t->cache_tex);
+      gl.DeleteTextures(5, t->cache_tex);
       gl.DeleteRenderbuffers(1, &t->cache_depth_rbo);
     }
   }
@@ -267,6 +285,7 @@ Renderer::~Renderer() {
   gl.DeleteProgram(shadow_program_);
   gl.DeleteProgram(mark_program_);
   gl.DeleteVertexArrays(1, &mark_vao_);
+  gl.DeleteBuffers(1, &mark_vbo_);
 }
 
 const Camera& Renderer::RenderCamera(int index) const { return targets_.at(index)->render_camera; }
@@ -485,15 +504,6 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
   gl.Uniform1i(gl.GetUniformLocation(program_, "u_shadow_maps"), 1);
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_size_uv"), 4, size_uv.data());
   gl.Uniform1fv(gl.GetUniformLocation(program_, "u_shadow_texel"), 4, texel.data());
-  gl.UseProgram(mark_program_);
-  gl.Uniform1i(gl.GetUniformLocation(mark_program_, "u_slot_count"), static_cast<int>(shadow_maps_.size()));
-  for (int k = 0; k < 4; ++k) {
-    const std::string index = "[" + std::to_string(k) + "]";
-    gl.UniformMatrix4fv(gl.GetUniformLocation(mark_program_, ("u_shadow_clip_from_world" + index).c_str()), 1,
-                        GL_FALSE, shadow_clip[k].data());
-  }
-  gl.Uniform1fv(gl.GetUniformLocation(mark_program_, "u_shadow_texel"), 4, texel.data());
-  gl.Uniform1i(gl.GetUniformLocation(mark_program_, "u_static_world"), 8);
   shadows_dirty_ = true;
   static_shadows_dirty_ = true;
   static_cache_dirty_ = true;
@@ -561,12 +571,19 @@ void Renderer::UpdateShadows() {
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   // The person's extent in each shadow map, for the static visibility: all of
   // it when a vertex lies behind the light, none when nobody is drawn.
-  std::vector<Eigen::Vector4f> boxes(4, Eigen::Vector4f(2, 2, -2, -2));
+  std::array<Eigen::Vector4f, 4>& boxes = person_boxes_;
+  boxes.fill(Eigen::Vector4f(2, 2, -2, -2));
+  person_nearest_.fill(-1e30f);
   const bool person_drawn = person_visible_ && person_index_count_ > 0;
   for (size_t k = 0; k < shadow_maps_.size() && person_drawn; ++k) {
     Eigen::Vector4f& box = boxes[k];
-    if (person_positions_.size() != person_vertex_count_) box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
+    if (person_positions_.size() != person_vertex_count_) {
+      box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
+      continue;
+    }
+    float nearest = 1e30f;
     for (const Eigen::Vector3f& p : person_positions_) {
+      nearest = std::min(nearest, (shadow_maps_[k]->cam_from_world * p.homogeneous()).z());
       const Eigen::Vector4f clip = shadow_maps_[k]->clip_from_world * p.homogeneous();
       if (!(clip.w() > 1e-6f)) {
         box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
@@ -575,9 +592,8 @@ void Renderer::UpdateShadows() {
       const float u = clip.x() / clip.w() * 0.5f + 0.5f, v = clip.y() / clip.w() * 0.5f + 0.5f;
       box = Eigen::Vector4f(std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v));
     }
+    person_nearest_[k] = box[0] < -1e8f ? -1e30f : nearest;
   }
-  gl.UseProgram(mark_program_);
-  gl.Uniform4fv(gl.GetUniformLocation(mark_program_, "u_person_box"), 4, boxes[0].data());
   shadows_dirty_ = false;
 }
 
@@ -595,17 +611,56 @@ void Renderer::UpdateStaticCache() {
   }
   const float zero[4] = {0, 0, 0, 0};
   const float no_surface[4] = {0, 0, 0, -1};
+  const float no_taps[4] = {-1e30f, -1e30f, -1e30f, -1e30f};
   for (const auto& target : targets_) {
     gl.BindFramebuffer(GL_FRAMEBUFFER, target->cache_fbo);
     BeginCameraPass(*target);
     for (int i = 0; i < 3; ++i) gl.ClearBufferfv(GL_COLOR, i, zero);
     gl.ClearBufferfv(GL_COLOR, 3, no_surface);
+    gl.ClearBufferfv(GL_COLOR, 4, no_taps);
     gl.ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
     DrawStatic(gl.GetUniformLocation(program_, "u_person"));
+    if (!shadow_maps_.empty()) TileStaticCache(*target);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while drawing the static scene's cache");
   static_cache_dirty_ = false;
+}
+
+void Renderer::TileStaticCache(Target& t) {
+  // The cache's world points and reach, read back once, summarised per tile.
+  const GlFunctions& gl = gl_;
+  const Camera& rc = t.render_camera;
+  cv::Mat world(rc.height, rc.width, CV_32FC4);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT3);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RGBA, GL_FLOAT, world.data);
+  cv::Mat blocker_depth(rc.height, rc.width, CV_32FC4);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT4);
+  gl.ReadPixels(0, 0, rc.width, rc.height, GL_RGBA, GL_FLOAT, blocker_depth.data);
+  t.tiles_x = (rc.width + kTile - 1) / kTile;
+  t.tiles_y = (rc.height + kTile - 1) / kTile;
+  const Eigen::Vector4f empty(2, 2, -2, -2);
+  t.tile_uv.assign(size_t(t.tiles_x) * t.tiles_y, {empty, empty, empty, empty});
+  t.tile_reach.assign(t.tile_uv.size(), 0.0f);
+  t.tile_blocker_depth.assign(t.tile_uv.size(), Eigen::Vector4f::Constant(-1e30f));
+  for (int y = 0; y < rc.height; ++y) {
+    for (int x = 0; x < rc.width; ++x) {
+      const cv::Vec4f& w = world.at<cv::Vec4f>(y, x);
+      if (w[3] < 0) continue;  // no static surface
+      const size_t tile = size_t(y / kTile) * t.tiles_x + x / kTile;
+      t.tile_reach[tile] = std::max(t.tile_reach[tile], w[3]);
+      const cv::Vec4f& z = blocker_depth.at<cv::Vec4f>(y, x);
+      t.tile_blocker_depth[tile] = t.tile_blocker_depth[tile].cwiseMax(Eigen::Vector4f(z[0], z[1], z[2], z[3]));
+      for (size_t k = 0; k < shadow_maps_.size(); ++k) {
+        const Eigen::Vector4f clip = shadow_maps_[k]->clip_from_world * Eigen::Vector4f(w[0], w[1], w[2], 1.0f);
+        if (!(clip.w() > 0)) continue;  // behind the light: no taps
+        const float u = clip.x() / clip.w() * 0.5f + 0.5f, v = clip.y() / clip.w() * 0.5f + 0.5f;
+        Eigen::Vector4f& box = t.tile_uv[tile][k];
+        box = Eigen::Vector4f(std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v));
+      }
+    }
+  }
 }
 
 void Renderer::SetPersonTopology(const std::vector<uint32_t>& indices, size_t vertex_count) {
@@ -762,22 +817,47 @@ void Renderer::Draw(int index) {
 }
 
 void Renderer::ShadeShadowedPixels(const Target& t) {
-  // Stencil 0 -> 1 on the static pixels (not the person's) whose shadow taps
-  // may read the person's texels (the mark pass writes no colour), then the
-  // static scene drawn again where it is the surface seen (equal depth) and
-  // marked: the first fragment at that depth, as in a full draw (1 -> 2).
+  // Stencil 0 -> 1 on the static pixels (not the person's) of every tile
+  // whose shadow taps may come within two texels of the person's extent in a
+  // shadow map (the mark pass writes no colour), then the static scene drawn
+  // again where it is the surface seen (equal depth) and marked: the first
+  // fragment at that depth, as in a full draw (1 -> 2).
   const GlFunctions& gl = gl_;
+  const Camera& rc = t.render_camera;
+  const float texel = 1.0f / options_.shadow_map_size;
+  std::vector<float> quads;
+  for (int ty = 0; ty < t.tiles_y; ++ty) {
+    for (int tx = 0; tx < t.tiles_x; ++tx) {
+      const size_t tile = size_t(ty) * t.tiles_x + tx;
+      const float margin = t.tile_reach[tile] + 2 * texel;
+      bool near = false;
+      for (size_t k = 0; k < shadow_maps_.size() && !near; ++k) {
+        const Eigen::Vector4f& a = t.tile_uv[tile][k];
+        const Eigen::Vector4f& b = person_boxes_[k];
+        // The person's texels are no nearer to the light than its nearest
+        // vertex; one at least as far as every tap's comparison is no blocker
+        // (1 cm of slack for rounding).
+        near = t.tile_blocker_depth[tile][k] + 0.01f > person_nearest_[k] && a[0] <= a[2] && a[0] - margin <= b[2] && a[2] + margin >= b[0] && a[1] - margin <= b[3] &&
+               a[3] + margin >= b[1];
+      }
+      if (!near) continue;
+      const float x0 = 2.0f * tx * kTile / rc.width - 1, x1 = 2.0f * std::min((tx + 1) * kTile, rc.width) / rc.width - 1;
+      const float y0 = 2.0f * ty * kTile / rc.height - 1,
+                  y1 = 2.0f * std::min((ty + 1) * kTile, rc.height) / rc.height - 1;
+      quads.insert(quads.end(), {x0, y0, x1, y0, x1, y1, x0, y0, x1, y1, x0, y1});
+    }
+  }
+  if (quads.empty()) return;
   gl.StencilFunc(GL_EQUAL, 0, 0xFF);
   gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR);
   gl.Disable(GL_DEPTH_TEST);
   const GLenum none[] = {GL_NONE};
   gl.DrawBuffers(1, none);
   gl.UseProgram(mark_program_);
-  gl.ActiveTexture(GL_TEXTURE8);
-  gl.BindTexture(GL_TEXTURE_2D, t.cache_tex[3]);
-  gl.ActiveTexture(GL_TEXTURE0);
   gl.BindVertexArray(mark_vao_);
-  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl.BindBuffer(GL_ARRAY_BUFFER, mark_vbo_);
+  gl.BufferData(GL_ARRAY_BUFFER, quads.size() * sizeof(float), quads.data(), GL_STREAM_DRAW);
+  gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 2));
   gl.BindVertexArray(0);
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
   gl.DrawBuffers(3, buffers);

@@ -6,6 +6,7 @@
 // CPU (docs/truth.md). The person mesh is uploaded once per frame and drawn by every camera.
 
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -114,6 +115,7 @@ class Renderer {
   void UpdateStaticCache();
   void BeginCameraPass(const Target& t);
   void ShadeShadowedPixels(const Target& t);
+  void TileStaticCache(Target& t);
   void DrawPerson(int person_flag_location);
   void DrawStatic(int person_flag_location);
   void Draw(int index);
@@ -137,7 +139,11 @@ class Renderer {
   unsigned static_shadow_array_ = 0;
   bool static_shadows_dirty_ = true;
   bool static_cache_dirty_ = true;
-  unsigned mark_program_ = 0, mark_vao_ = 0;
+  unsigned mark_program_ = 0, mark_vao_ = 0, mark_vbo_ = 0;
+  // The person's extent in each shadow map (min u, min v, max u, max v).
+  std::array<Eigen::Vector4f, 4> person_boxes_;
+  // Its nearest camera-frame z from each shadow-mapped light.
+  std::array<float, 4> person_nearest_;
   std::vector<Eigen::Vector3f> person_positions_;  // the last UpdatePerson's
   unsigned bounce_textures_[6] = {0, 0, 0, 0, 0, 0};  // GL_TEXTURE_3D, one per axis direction
   bool shadows_dirty_ = true;

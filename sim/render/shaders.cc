@@ -78,8 +78,11 @@ layout(location = 0) out vec4 o_radiance;  // 850 nm, 940 nm, content, emission
 layout(location = 1) out float o_mask;
 layout(location = 2) out float o_depth;
 // For the static scene's cache (Renderer::UpdateStaticCache): the surface's
-// world point, and how far from its uv in any shadow map the taps read.
+// world point, and how far from its uv in any shadow map the taps read; per
+// shadow slot, the largest depth a tap compares a shadow-map texel with (a
+// texel at least that far from the light is no blocker; -1e30: no taps).
 layout(location = 3) out vec4 o_world;
+layout(location = 4) out vec4 o_blocker_depth;
 
 #if SHADOWS
 float ShadowDepth(int slot, vec2 uv) { return texture(u_shadow_maps, vec3(uv, float(slot))).r; }
@@ -155,6 +158,7 @@ void main() {
   if (dot(n, u_camera_center - v_world) < 0.0) n = -n;  // two-sided
   vec4 radiance = vec4(0.0);
   o_world = vec4(v_world, 0.0);
+  o_blocker_depth = vec4(-1e30);
   if (v_material.y > 0.5) {
     radiance.a = v_material.x;
   } else {
@@ -172,8 +176,10 @@ void main() {
 #if SHADOWS
       if (slot >= 0) {
         float reach;
-        vis = Visibility(slot, InShadowMap(slot, v_world), cone * lambert > 0.0 ? 9 : 0, reach);
+        ShadowPoint s = InShadowMap(slot, v_world);
+        vis = Visibility(slot, s, cone * lambert > 0.0 ? 9 : 0, reach);
         o_world.w = max(o_world.w, reach);
+        o_blocker_depth[slot] = reach > 0.0 ? s.z_r + (abs(s.dz_duv.x) + abs(s.dz_duv.y)) * reach : -1e30;
       }
 #endif
       float e = u_light_power[i] * cone * lambert * vis / d2;
@@ -209,39 +215,15 @@ layout(location = 0) out float o_z;
 void main() { o_z = v_z; }
 )";
 
-// The static pixels the person's shadows may change this frame: a full-screen
-// pass over the static cache (Renderer::MarkShadowedPixels) that keeps the
-// pixels whose shadow taps, in some shadow map, come within two texels of the
-// person's extent there (u_person_box: min u, min v, max u, max v).
+// The mark pass of the static scene's cache (Renderer::ShadeShadowedPixels):
+// quads over the tiles of pixels the person's shadows may reach, stencil only.
 const char* const kMarkVertexShader = R"(#version 330 core
-void main() {
-  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
-  gl_Position = vec4(p, 0.0, 1.0);
-}
+layout(location = 0) in vec2 a_ndc;
+void main() { gl_Position = vec4(a_ndc, 0.0, 1.0); }
 )";
 
 const char* const kMarkFragmentShader = R"(#version 330 core
-uniform sampler2D u_static_world;  // world point, the taps' reach (< 0: no surface)
-uniform int u_slot_count;
-uniform mat4 u_shadow_clip_from_world[4];
-uniform float u_shadow_texel[4];
-uniform vec4 u_person_box[4];
-layout(location = 0) out vec4 o_unused;
-void main() {
-  ivec2 px = ivec2(gl_FragCoord.xy);
-  vec4 world = texelFetch(u_static_world, px, 0);
-  bool near = false;
-  for (int k = 0; k < u_slot_count; ++k) {
-    vec4 clip = u_shadow_clip_from_world[k] * vec4(world.xyz, 1.0);
-    vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-    vec4 box = u_person_box[k];
-    float margin = world.w + 2.0 * u_shadow_texel[k];
-    near = near || (clip.w > 0.0 && uv.x + margin >= box.x && uv.x - margin <= box.z &&
-                    uv.y + margin >= box.y && uv.y - margin <= box.w);
-  }
-  if (world.w < 0.0 || !near) discard;
-  o_unused = vec4(0.0);
-}
+void main() {}
 )";
 
 }  // namespace irbench::shaders

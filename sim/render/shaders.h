@@ -1,6 +1,6 @@
 #pragma once
 // The renderer's GLSL programs (sim/render/renderer.cc): the scene's shading,
-// the shadow maps' depth, and the mark pass of the static scene's cache.
+// the shadow maps' depth, and the stencil marks of the static scene's cache.
 
 namespace irbench::shaders {
 

@@ -112,6 +112,7 @@ RenderOptions RenderOptionsFor(const RenderJobOptions& options, const RenderInpu
   RenderOptions render_options;
   render_options.supersample = options.supersample;
   render_options.shadows = options.shadows.value_or(in.models_sensor);
+  render_options.static_cache = options.static_cache;
   return render_options;
 }
 

@@ -49,6 +49,9 @@ struct RenderJobOptions {
   // Soft shadows of the scene's lights; default: on with a sensor preset other
   // than clean.
   std::optional<bool> shadows;
+  // The static scene drawn once per camera and reused (RenderOptions::
+  // static_cache): the same bytes either way; off only to compare.
+  bool static_cache = true;
 };
 
 // The screens' level in empty-stage frame `index` of `count` with the
