@@ -612,8 +612,21 @@ void Renderer::UpdateStaticCache() {
   const float zero[4] = {0, 0, 0, 0};
   const float no_surface[4] = {0, 0, 0, -1};
   const float no_taps[4] = {-1e30f, -1e30f, -1e30f, -1e30f};
+  // The world points and blocker depths are needed only until they are
+  // summarised per tile: attached at full size while drawing, then detached
+  // (a framebuffer's extent is its smallest attachment's) and shrunk to 1x1.
+  const auto size_scratch = [&](Target& t, bool full) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, t.cache_fbo);
+    for (int i : {3, 4}) {
+      gl.BindTexture(GL_TEXTURE_2D, t.cache_tex[i]);
+      gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, full ? t.render_camera.width : 1,
+                    full ? t.render_camera.height : 1, 0, GL_RGBA, GL_FLOAT, nullptr);
+      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + i, GL_TEXTURE_2D, full ? t.cache_tex[i] : 0, 0);
+    }
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+  };
   for (const auto& target : targets_) {
-    gl.BindFramebuffer(GL_FRAMEBUFFER, target->cache_fbo);
+    size_scratch(*target, true);
     BeginCameraPass(*target);
     for (int i = 0; i < 3; ++i) gl.ClearBufferfv(GL_COLOR, i, zero);
     gl.ClearBufferfv(GL_COLOR, 3, no_surface);
@@ -621,6 +634,7 @@ void Renderer::UpdateStaticCache() {
     gl.ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
     DrawStatic(gl.GetUniformLocation(program_, "u_person"));
     if (!shadow_maps_.empty()) TileStaticCache(*target);
+    size_scratch(*target, false);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while drawing the static scene's cache");
