@@ -112,6 +112,7 @@ class Renderer {
   struct Target;
   struct ShadowMap;
   void UpdateShadows();
+  void UpdatePersonExtents();
   void UpdateStaticCache();
   void BeginCameraPass(const Target& t);
   void ShadeShadowedPixels(const Target& t);

@@ -1,0 +1,48 @@
+#pragma once
+// The renderer's per-camera targets and shadow maps, shared by its two
+// sources (renderer.cc: set-up and the draw; static_cache.cc: the static
+// scene's cache). Not part of the library's interface.
+
+#include <Eigen/Core>
+#include <array>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sim/render/renderer.h"
+
+namespace irbench {
+
+inline constexpr int kStaticCacheTile = 8;  // pixels per side of the static cache's tiles
+
+struct Renderer::ShadowMap {
+  unsigned fbo = 0, depth_rbo = 0;
+  unsigned static_fbo = 0, static_depth_rbo = 0;  // the static scene alone
+  Eigen::Matrix4f clip_from_world, cam_from_world;
+  // Texels (x0, y0, x1, y1, ends excluded) that may differ from the static
+  // scene's: where the person was last drawn; all of them at first.
+  Eigen::Vector4i dirty{0, 0, 1 << 30, 1 << 30};
+};
+
+struct Renderer::Target {
+  Camera render_camera;  // the supersampled pinhole actually rasterised
+  unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
+  // The static scene alone, drawn once (UpdateStaticCache): what fbo's three
+  // images and its depth hold before the person is drawn, and per pixel the
+  // surface's world point and its shadow taps' reach (MarkShadowedPixels).
+  unsigned cache_fbo = 0, cache_depth_rbo = 0;
+  // radiance, mask, depth, world point and reach, blocker depth per slot
+  unsigned cache_tex[5] = {0, 0, 0, 0, 0};
+  // Per tile of kStaticCacheTile x kStaticCacheTile pixels of the cache (row-major): per shadow slot
+  // the uv extent of its static surfaces (min u, min v, max u, max v; empty
+  // when min > max), how far their taps read beyond it, and the largest depth
+  // a tap compares with per slot.
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<std::array<Eigen::Vector4f, 4>> tile_uv;
+  std::vector<float> tile_reach;
+  std::vector<Eigen::Vector4f> tile_blocker_depth;
+  cv::Mat map_x, map_y;  // output pixel -> render pixel
+  cv::Mat raw_half, raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
+  Eigen::Matrix4f clip_from_world;
+};
+
+}  // namespace irbench
