@@ -27,15 +27,17 @@ struct Renderer::Target {
   Camera render_camera;  // the supersampled pinhole actually rasterised
   unsigned fbo = 0, grey_tex = 0, mask_tex = 0, depth_tex = 0, depth_rbo = 0;
   // The static scene alone, drawn once (UpdateStaticCache): what fbo's three
-  // images and its depth hold before the person is drawn, and per pixel the
-  // surface's world point and its shadow taps' reach (MarkShadowedPixels).
+  // images and its depth hold before the person is drawn, and, until they are
+  // summarised per tile (TileStaticCache), per pixel the surface's world point
+  // with its shadow taps' reach and per shadow slot the deepest depth a tap
+  // compares with. cache_tex: radiance, mask, depth, world point and reach,
+  // blocker depths.
   unsigned cache_fbo = 0, cache_depth_rbo = 0;
-  // radiance, mask, depth, world point and reach, blocker depth per slot
   unsigned cache_tex[5] = {0, 0, 0, 0, 0};
-  // Per tile of kStaticCacheTile x kStaticCacheTile pixels of the cache (row-major): per shadow slot
-  // the uv extent of its static surfaces (min u, min v, max u, max v; empty
-  // when min > max), how far their taps read beyond it, and the largest depth
-  // a tap compares with per slot.
+  // Per tile of kStaticCacheTile pixels a side (row-major), for
+  // ShadeShadowedPixels: per shadow slot the uv extent of its static surfaces
+  // (min u, min v, max u, max v; empty when min > max), how far their taps
+  // read beyond it, and the largest depth a tap compares with per slot.
   int tiles_x = 0, tiles_y = 0;
   std::vector<std::array<Eigen::Vector4f, 4>> tile_uv;
   std::vector<float> tile_reach;
