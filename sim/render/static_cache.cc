@@ -9,33 +9,50 @@
 #include "sim/render/renderer_internal.h"
 
 namespace irbench {
+namespace {
+
+// Extents in a shadow map's uv (min u, min v, max u, max v): none, and all.
+const Eigen::Vector4f kNoUv(2, 2, -2, -2);
+const Eigen::Vector4f kAllUv(-1e9f, -1e9f, 1e9f, 1e9f);
+
+// Grows `box` by a point in front of the light, given in its clip coordinates.
+void Extend(Eigen::Vector4f& box, const Eigen::Vector4f& clip) {
+  const float u = clip.x() / clip.w() * 0.5f + 0.5f, v = clip.y() / clip.w() * 0.5f + 0.5f;
+  box = Eigen::Vector4f(std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v));
+}
+
+// Whether non-empty `a`, `margin` wider on every side, meets `b`.
+bool Meets(const Eigen::Vector4f& a, float margin, const Eigen::Vector4f& b) {
+  return a[0] <= a[2] && a[0] - margin <= b[2] && a[2] + margin >= b[0] && a[1] - margin <= b[3] &&
+         a[3] + margin >= b[1];
+}
+
+}  // namespace
 
 void Renderer::UpdatePersonExtents() {
   // The person's extent in each shadow map (for its restore and the static
   // cache): all of it when a vertex lies behind the light, none when nobody
   // is drawn.
-  std::array<Eigen::Vector4f, 4>& boxes = person_boxes_;
-  boxes.fill(Eigen::Vector4f(2, 2, -2, -2));
+  person_boxes_.fill(kNoUv);
   person_nearest_.fill(-1e30f);
   const bool person_drawn = person_visible_ && person_index_count_ > 0;
   for (size_t k = 0; k < shadow_maps_.size() && person_drawn; ++k) {
-    Eigen::Vector4f& box = boxes[k];
+    Eigen::Vector4f& box = person_boxes_[k];
     if (person_positions_.size() != person_vertex_count_) {
-      box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
+      box = kAllUv;
       continue;
     }
     float nearest = 1e30f;
+    bool behind = false;
     for (const Eigen::Vector3f& p : person_positions_) {
       nearest = std::min(nearest, (shadow_maps_[k]->cam_from_world * p.homogeneous()).z());
       const Eigen::Vector4f clip = shadow_maps_[k]->clip_from_world * p.homogeneous();
-      if (!(clip.w() > 1e-6f)) {
-        box = Eigen::Vector4f(-1e9f, -1e9f, 1e9f, 1e9f);
-        break;
-      }
-      const float u = clip.x() / clip.w() * 0.5f + 0.5f, v = clip.y() / clip.w() * 0.5f + 0.5f;
-      box = Eigen::Vector4f(std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v));
+      behind = !(clip.w() > 1e-6f);
+      if (behind) break;
+      Extend(box, clip);
     }
-    person_nearest_[k] = box[0] < -1e8f ? -1e30f : nearest;
+    if (behind) box = kAllUv;
+    person_nearest_[k] = behind ? -1e30f : nearest;
   }
 }
 
@@ -96,8 +113,7 @@ void Renderer::TileStaticCache(Target& t) {
   gl.ReadPixels(0, 0, rc.width, rc.height, GL_RGBA, GL_FLOAT, blocker_depth.data);
   t.tiles_x = (rc.width + kStaticCacheTile - 1) / kStaticCacheTile;
   t.tiles_y = (rc.height + kStaticCacheTile - 1) / kStaticCacheTile;
-  const Eigen::Vector4f empty(2, 2, -2, -2);
-  t.tile_uv.assign(size_t(t.tiles_x) * t.tiles_y, {empty, empty, empty, empty});
+  t.tile_uv.assign(size_t(t.tiles_x) * t.tiles_y, {kNoUv, kNoUv, kNoUv, kNoUv});
   t.tile_reach.assign(t.tile_uv.size(), 0.0f);
   t.tile_blocker_depth.assign(t.tile_uv.size(), Eigen::Vector4f::Constant(-1e30f));
   for (int y = 0; y < rc.height; ++y) {
@@ -110,10 +126,7 @@ void Renderer::TileStaticCache(Target& t) {
       t.tile_blocker_depth[tile] = t.tile_blocker_depth[tile].cwiseMax(Eigen::Vector4f(z[0], z[1], z[2], z[3]));
       for (size_t k = 0; k < shadow_maps_.size(); ++k) {
         const Eigen::Vector4f clip = shadow_maps_[k]->clip_from_world * Eigen::Vector4f(w[0], w[1], w[2], 1.0f);
-        if (!(clip.w() > 0)) continue;  // behind the light: no taps
-        const float u = clip.x() / clip.w() * 0.5f + 0.5f, v = clip.y() / clip.w() * 0.5f + 0.5f;
-        Eigen::Vector4f& box = t.tile_uv[tile][k];
-        box = Eigen::Vector4f(std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v));
+        if (clip.w() > 0) Extend(t.tile_uv[tile][k], clip);  // behind the light: no taps
       }
     }
   }
@@ -135,18 +148,17 @@ void Renderer::ShadeShadowedPixels(const Target& t) {
       const float margin = t.tile_reach[tile] + 2 * texel;
       bool near = false;
       for (size_t k = 0; k < shadow_maps_.size() && !near; ++k) {
-        const Eigen::Vector4f& a = t.tile_uv[tile][k];
-        const Eigen::Vector4f& b = person_boxes_[k];
         // The person's texels are no nearer to the light than its nearest
         // vertex; one at least as far as every tap's comparison is no blocker
         // (1 cm of slack for rounding).
-        near = t.tile_blocker_depth[tile][k] + 0.01f > person_nearest_[k] && a[0] <= a[2] && a[0] - margin <= b[2] && a[2] + margin >= b[0] && a[1] - margin <= b[3] &&
-               a[3] + margin >= b[1];
+        near = t.tile_blocker_depth[tile][k] + 0.01f > person_nearest_[k] &&
+               Meets(t.tile_uv[tile][k], margin, person_boxes_[k]);
       }
       if (!near) continue;
-      const float x0 = 2.0f * tx * kStaticCacheTile / rc.width - 1, x1 = 2.0f * std::min((tx + 1) * kStaticCacheTile, rc.width) / rc.width - 1;
-      const float y0 = 2.0f * ty * kStaticCacheTile / rc.height - 1,
-                  y1 = 2.0f * std::min((ty + 1) * kStaticCacheTile, rc.height) / rc.height - 1;
+      // The tile's pixels in normalised device coordinates.
+      const auto ndc = [](int pixel, int size) { return 2.0f * std::min(pixel, size) / size - 1; };
+      const float x0 = ndc(tx * kStaticCacheTile, rc.width), x1 = ndc((tx + 1) * kStaticCacheTile, rc.width);
+      const float y0 = ndc(ty * kStaticCacheTile, rc.height), y1 = ndc((ty + 1) * kStaticCacheTile, rc.height);
       quads.insert(quads.end(), {x0, y0, x1, y0, x1, y1, x0, y0, x1, y1, x0, y1});
     }
   }
