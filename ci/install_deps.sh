@@ -19,6 +19,7 @@ PACKAGES=(
   chromium      # the report's test opens it in headless Chromium
   python3       # ci/checks/code_shape.py (a CTest test): function and file sizes, layering
   clang libclang-rt-14-dev  # ci/sanitize.sh: ASan, UBSan and libFuzzer (fuzz/)
+  munge slurmctld slurmd slurm-client  # `irbench sweep submit`: its test starts a one-node Slurm (ci/slurm/)
 )
 
 missing=()

@@ -31,6 +31,8 @@ std::vector<Command> AddTrackCommand(CLI::App& app);
 std::vector<Command> AddDemoCommand(CLI::App& app);
 // Adds `suite run`: the closed-loop accuracy regression.
 std::vector<Command> AddSuiteCommand(CLI::App& app);
+// Adds `sweep run|run-one|submit|collect`: stress sweeps.
+std::vector<Command> AddSweepCommand(CLI::App& app);
 // Adds `score`: a track file against the sequence's truth.
 std::vector<Command> AddScoreCommand(CLI::App& app);
 // Adds `motion list|info|export`.

@@ -28,7 +28,7 @@ std::vector<Command> AddCommands(CLI::App& app) {
   using AddCommandFn = std::vector<Command> (*)(CLI::App&);
   std::vector<Command> commands;
   for (AddCommandFn add : {irbench::cli::AddRenderCommand, irbench::cli::AddTrackCommand,
-                           irbench::cli::AddDemoCommand, irbench::cli::AddSuiteCommand,
+                           irbench::cli::AddDemoCommand, irbench::cli::AddSuiteCommand, irbench::cli::AddSweepCommand,
                            irbench::cli::AddScoreCommand, irbench::cli::AddMotionCommand,
                            irbench::cli::AddAvatarCommand, irbench::cli::AddTrainCommand,
                            irbench::cli::AddFaultCommand, irbench::cli::AddExportCommand, irbench::cli::AddLiveCommand,

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "ci/report/report.h"
+#include "ci/suite_runner/scenario.h"
 #include "ci/score/score.h"
 #include "ci/score/score_job.h"
 #include "common/atomic_file.h"
@@ -35,69 +36,20 @@ struct Bound {
   double tolerance = 0;  // allowed drift from the baseline, absolute
 };
 
-struct Scenario {
-  std::string name;
-  std::string suite_file;  // the file that lists it (a suite or one it includes)
-  RenderJobOptions render;
-  bool optional = false;  // skipped, with a warning, when its motion file is absent
-  std::string missing;    // why it is skipped; empty: it runs
-  TrackerSettings tracker;  // the scenario's `track` object: keys of TrackSettings()
+struct SuiteScenario : Scenario {
   std::map<std::string, Bound> thresholds;
 };
-
-// The metrics a threshold may name: see suite.h.
-const std::vector<std::string>& KnownMetrics() {
-  static const std::vector<std::string> m = [] {
-    std::vector<std::string> out = {"silhouette_iou_median", "tracked_fraction", "arms_mean_cm",
-                                    "pointing_mean_deg", "rest_accuracy", "posture_accuracy",
-                                    "gesture_identification", "motion_mean_recall"};
-    for (const std::string& joint : ScoredJoints()) out.push_back(joint + "_mean_cm");
-    return out;
-  }();
-  return m;
-}
-
-std::string KnownMetricsText() {
-  std::string out;
-  for (const std::string& m : KnownMetrics()) out += (out.empty() ? "" : ", ") + m;
-  return out;
-}
-
-// A scenario's `track` object: any setting of TrackSettings() by its key; a
-// relative path (rest_model) is relative to the suite file's folder.
-void ReadTrackerSettings(const JsonNode& t, const fs::path& suite_file, TrackerSettings& settings) {
-  std::vector<std::string> keys;
-  for (const TrackSetting& setting : TrackSettings()) keys.push_back(setting.key);
-  t.CheckKeys(keys);
-  for (const TrackSetting& setting : TrackSettings()) {
-    if (!t.Has(setting.key)) continue;
-    SetFromJson(setting, t[setting.key], settings);
-    if (const auto* path = std::get_if<PathBinding>(&setting.binding)) {
-      fs::path& value = path->ref(settings);
-      if (!value.empty() && value.is_relative()) value = suite_file.parent_path() / value;
-    }
-  }
-}
 
 fs::path FindSuiteFile(const fs::path& suite) {
   return fs::is_regular_file(suite) ? suite : ResolveDataFile("ci/suites", suite.string(), "SUITE");
 }
 
-// A scenario's motion: a library or motions/ name as it stands; a motion file
-// (a path with a folder or an extension) relative to the suite file's folder.
-std::string ScenarioMotion(const std::string& motion, const fs::path& suite_file) {
-  const fs::path as_path(motion);
-  const bool looks_like_path = motion.find('/') != std::string::npos || as_path.has_extension();
-  if (!looks_like_path || as_path.is_absolute()) return motion;
-  return (suite_file.parent_path() / as_path).lexically_normal().string();
-}
-
-void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vector<Scenario>* out);
+void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vector<SuiteScenario>* out);
 
 // `include`: the scenarios of other suites (names in ci/suites/ or files
 // relative to this one), in order, before this suite's own.
 void ReadIncludes(const JsonNode& list, const fs::path& file, std::vector<fs::path>* chain,
-                  std::vector<Scenario>* out) {
+                  std::vector<SuiteScenario>* out) {
   for (size_t i = 0; i < list.Size(); ++i) {
     const std::string name = list[i].String();
     fs::path other = name;
@@ -117,7 +69,7 @@ void ReadIncludes(const JsonNode& list, const fs::path& file, std::vector<fs::pa
   }
 }
 
-void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vector<Scenario>* out) {
+void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vector<SuiteScenario>* out) {
   chain->push_back(file);
   const JsonNode root = ParseJsonFile(file.string());
   root.CheckKeys({"format", "name", "description", "include", "scenarios"});
@@ -127,44 +79,15 @@ void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vect
   if (list.Size() == 0 && !root.Has("include")) list.Fail("no scenarios");
   for (size_t i = 0; i < list.Size(); ++i) {
     const JsonNode s = list[i];
-    s.CheckKeys({"name", "scene", "rig", "avatar", "motion", "optional", "max_seconds", "sensor", "seed", "frames",
-                 "background_frames", "background_screen_sweep", "track", "thresholds"});
-    Scenario sc;
+    std::vector<std::string> keys = ScenarioKeys();
+    keys.insert(keys.end(), {"name", "thresholds"});
+    s.CheckKeys(keys);
+    SuiteScenario sc;
     sc.name = s.GetString("name");
-    sc.suite_file = file.string();
-    for (const Scenario& other : *out) {
-      if (other.name == sc.name) s["name"].Fail("'" + sc.name + "' appears twice (also in " + other.suite_file + ")");
+    for (const SuiteScenario& other : *out) {
+      if (other.name == sc.name) s["name"].Fail("'" + sc.name + "' appears twice (also in " + other.file + ")");
     }
-    sc.render.scene = s.GetString("scene", "");
-    sc.render.rig = s.GetString("rig", "theater4");
-    sc.render.avatar = s.GetString("avatar", "p1");
-    sc.render.motion = ScenarioMotion(s.GetString("motion", "demo"), file);
-    sc.optional = s.GetBool("optional", false);
-    const bool motion_is_file = sc.render.motion.find('/') != std::string::npos || fs::path(sc.render.motion).has_extension();
-    if (sc.optional && motion_is_file && !fs::is_regular_file(sc.render.motion)) {
-      sc.missing = "no motion file " + sc.render.motion;
-    }
-    sc.render.sensor = s.GetString("sensor", "thesis");
-    sc.render.seed = static_cast<uint64_t>(s.GetInt("seed", 1));
-    if (s.Has("frames") && s.Has("max_seconds")) s["max_seconds"].Fail("give frames or max_seconds, not both");
-    if (s.Has("frames")) {
-      sc.render.frames = s.GetInt("frames");
-      if (*sc.render.frames < 1) s["frames"].Fail("must be at least 1");
-    }
-    if (s.Has("max_seconds")) {
-      const double max_s = s.GetDouble("max_seconds");
-      if (!(max_s > 0 && max_s <= 3600)) s["max_seconds"].Fail("must be in (0, 3600]");
-      if (sc.missing.empty()) {
-        // The motion's own length, cut at max_seconds of the rig's frame rate.
-        const RenderInputs in = LoadRenderInputs(sc.render);
-        sc.render.frames =
-            std::max(1, std::min(in.frame_count, static_cast<int>(std::floor(max_s * in.fps + 1e-9))));
-      }
-    }
-    sc.render.background_frames = s.GetInt("background_frames", 12);
-    if (sc.render.background_frames < 2) s["background_frames"].Fail("the tracker needs at least 2");
-    sc.render.screen_sweep = s.GetBool("background_screen_sweep", true);
-    if (s.Has("track")) ReadTrackerSettings(s["track"], file, sc.tracker);
+    ReadScenarioKeys(s, file, &sc);
     const JsonNode th = s["thresholds"];
     for (const auto& [metric, value] : th.raw().items()) {
       if (std::find(KnownMetrics().begin(), KnownMetrics().end(), metric) == KnownMetrics().end()) {
@@ -185,10 +108,10 @@ void ReadSuiteFile(const fs::path& file, std::vector<fs::path>* chain, std::vect
   chain->pop_back();
 }
 
-std::vector<Scenario> ReadSuite(const fs::path& file, std::string* name) {
+std::vector<SuiteScenario> ReadSuite(const fs::path& file, std::string* name) {
   *name = ParseJsonFile(file.string()).GetString("name", file.stem().string());
   std::vector<fs::path> chain;
-  std::vector<Scenario> out;
+  std::vector<SuiteScenario> out;
   ReadSuiteFile(file, &chain, &out);
   return out;
 }
@@ -197,133 +120,6 @@ std::string Number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.4g", v);
   return buf;
-}
-
-// The files a scenario's render reads (validated, names resolved).
-std::vector<fs::path> ScenarioInputFiles(const RenderJobOptions& r) {
-  const RenderInputs in = LoadRenderInputs(r);
-  return {in.rig_file, in.scene_file, in.avatar_file, in.motion_file};
-}
-
-// The render inputs that decide the frames, hashed with the tool version and
-// the contents of the files they name.
-std::string CacheKey(const RenderJobOptions& r) {
-  const RenderInputs in = LoadRenderInputs(r);  // validates, resolves names to files
-  // A motion given as a path by its file name: its contents are in the key,
-  // its folder is not (the same clip beside another checkout hits the same
-  // cache). Names stay as they are.
-  const fs::path motion_path(r.motion);
-  const bool motion_is_path = r.motion.find('/') != std::string::npos || motion_path.has_extension();
-  const std::string motion = motion_is_path ? motion_path.filename().string() : r.motion;
-  std::string key = ToolVersion() + "|" + r.rig + "|" + r.scene + "|" + r.avatar + "|" + motion + "|" + r.sensor +
-                    "|" + std::to_string(r.seed) + "|" + std::to_string(r.frames.value_or(-1)) + "|" +
-                    std::to_string(r.background_frames) + "|" + std::to_string(r.supersample) +
-                    (SweepsScreens(r, in) ? "|sweep" : "");
-  for (const fs::path& f : {in.rig_file, in.scene_file, in.avatar_file, in.motion_file}) {
-    if (f.empty() || !fs::is_regular_file(f)) continue;
-    std::ifstream file(f, std::ios::binary);
-    key += std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  }
-  char hex[20];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(Fnv1a64(key)));
-  return hex;
-}
-
-// What one scenario measured: its metrics and, for pooling over scenarios,
-// how many samples each metric is a mean over.
-struct Measured {
-  std::map<std::string, double> metrics;
-  std::map<std::string, double> weights;
-  std::string group;  // "library" or "mocap" (the motion's kind)
-  std::string person;
-};
-
-Measured RunScenario(const Scenario& sc, const std::string& suite, const fs::path& cache, std::mutex* render_mutex,
-                     fs::path* report) {
-  const auto start = std::chrono::steady_clock::now();
-  // Render, or reuse the cached frames of the same inputs. One render at a
-  // time: each render job owns the process's GL display while it runs.
-  RenderJobOptions render = sc.render;
-  const fs::path seq = cache / (sc.name + "-" + CacheKey(render));
-  {
-    std::lock_guard<std::mutex> lock(*render_mutex);
-    if (!HasManifest(seq)) {
-      Log().info("suite {}: {}: rendering", suite, sc.name);
-      render.out = seq;
-      render.overwrite = true;
-      RunRenderJob(render);
-    } else {
-      Log().info("suite {}: {}: rendered before (cache {})", suite, sc.name, seq.filename().string());
-    }
-  }
-  TrackJobOptions track;
-  track.sequence = seq;
-  track.tracker = sc.tracker;
-  // The folder names the settings that differ from the defaults.
-  const std::string tag = NonDefaultSettingsTag(sc.tracker);
-  track.out = seq / (tag.empty() ? std::string("track") : "track-" + tag);
-  track.overwrite = true;
-  RunTrackJob(track);
-  ScoreJobOptions job;
-  job.sequence = seq;
-  job.track = track.out / "track.jsonl";
-  job.out = seq / ("score-" + track.out.filename().string());
-  job.overwrite = true;
-  Score score;
-  *report = RunScoreJob(job, nullptr, &score) / "report.html";
-  Measured out;
-  const std::string kind = ReadManifest(seq).json[manifest_key::kMotion].value("kind", "");
-  out.group = kind == "bvh" || kind == "amc" ? "mocap" : "library";
-  out.person = sc.render.avatar;
-  std::map<std::string, double>& metrics = out.metrics;
-  metrics["silhouette_iou_median"] = score.silhouettes ? score.silhouettes->All().iou_median : 0.0;
-  metrics["tracked_fraction"] = score.present_frames ? double(score.tracked_frames) / score.present_frames : 0.0;
-  out.weights["tracked_fraction"] = score.present_frames;
-  double arms = 0;
-  int arm_joints = 0;
-  for (const std::string& joint : ScoredJoints()) {
-    const ErrorStats& e = score.joints.at(joint);
-    if (e.total == 0) continue;
-    metrics[joint + "_mean_cm"] = e.mean;
-    out.weights[joint + "_mean_cm"] = e.total - e.outliers;
-    if (joint.find("shoulder") != std::string::npos || joint.find("elbow") != std::string::npos ||
-        joint.find("wrist") != std::string::npos) {
-      arms += e.mean;
-      ++arm_joints;
-    }
-  }
-  // Recognition (thesis 5.1, 5.3), when the tracker had the models.
-  if (score.posture.total > 0) {
-    metrics["posture_accuracy"] = score.posture.rate();
-    out.weights["posture_accuracy"] = score.posture.total;
-  }
-  if (score.gesture.total > 0) {
-    metrics["gesture_identification"] = score.gesture.rate();
-    out.weights["gesture_identification"] = score.gesture.total;
-  }
-  if (score.motion.total > 0) {
-    metrics["motion_mean_recall"] = MeanRecall(score.motion_confusion);
-    out.weights["motion_mean_recall"] = score.motion.total;
-  }
-  if (arm_joints) metrics["arms_mean_cm"] = arms / arm_joints;
-  // Pointing: the kept samples of both hands together.
-  double pointing = 0;
-  int kept = 0;
-  for (const auto& [hand, e] : score.pointing) {
-    pointing += e.mean * (e.total - e.outliers);
-    kept += e.total - e.outliers;
-  }
-  if (kept) {
-    metrics["pointing_mean_deg"] = pointing / kept;
-    out.weights["pointing_mean_deg"] = kept;
-  }
-  if (const auto it = score.rest.find("both"); it != score.rest.end() && it->second.total) {
-    metrics["rest_accuracy"] = it->second.rate();
-    out.weights["rest_accuracy"] = it->second.total;
-  }
-  Log().info("suite {}: {}: done in {:.0f} s", suite, sc.name,
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  return out;
 }
 
 // The scenarios' figures pooled per group and person: each metric the mean
@@ -453,7 +249,7 @@ std::string SuiteResult::PooledTable() const {
 SuiteResult RunSuite(const SuiteRunOptions& options) {
   const fs::path file = FindSuiteFile(options.suite);
   SuiteResult result;
-  std::vector<Scenario> scenarios = ReadSuite(file, &result.name);
+  std::vector<SuiteScenario> scenarios = ReadSuite(file, &result.name);
   // Optional scenarios whose data is absent (the CMU clips beside the
   // checkout) are skipped, said once each.
   for (auto it = scenarios.begin(); it != scenarios.end();) {
@@ -473,7 +269,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
   // The cache holds what the suite writes; it may not hold or lie in what it
   // reads (the suite file, the baselines, the scenarios' data files).
   std::vector<fs::path> inputs = {file, baselines_dir};
-  for (const Scenario& sc : scenarios) {
+  for (const SuiteScenario& sc : scenarios) {
     for (const fs::path& f : ScenarioInputFiles(sc.render)) inputs.push_back(f);
   }
   CheckOutputApart(cache, inputs, "--cache");
@@ -498,7 +294,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
     for (size_t i; (i = next++) < scenarios.size();) {
       try {
         Log().debug("suite {}: scenario {}/{}: {}", result.name, i + 1, scenarios.size(), scenarios[i].name);
-        measured[i] = RunScenario(scenarios[i], result.name, cache, &render_mutex, &reports[i]);
+        measured[i] = RunScenario(scenarios[i], "suite " + result.name, cache, &render_mutex, &reports[i]);
         const std::lock_guard<std::mutex> lock(progress_mutex);
         progress.Set(++finished, "scenarios done");
       } catch (...) {
@@ -517,7 +313,7 @@ SuiteResult RunSuite(const SuiteRunOptions& options) {
 
   nlohmann::json blessed = nlohmann::json::object();
   for (size_t i = 0; i < scenarios.size(); ++i) {
-    const Scenario& sc = scenarios[i];
+    const SuiteScenario& sc = scenarios[i];
     const std::map<std::string, double>& metrics = measured[i].metrics;
     result.reports.emplace_back(sc.name, reports[i]);
     for (const auto& [metric, bound] : sc.thresholds) {

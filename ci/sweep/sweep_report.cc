@@ -1,0 +1,329 @@
+// `irbench sweep collect`: the finished points merged into sweep.csv,
+// sweep.md and report.html (sweep.h).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include "ci/report/report.h"
+#include "ci/score/score.h"
+#include "ci/sweep/sweep.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/json_reader.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+namespace {
+
+struct Done {
+  int index = 0;
+  SweepPoint point;
+  nlohmann::json coordinates;
+  std::map<std::string, double> metrics;
+  std::string report;  // relative to the cache
+};
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+std::string Short(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3g", v);
+  return buf;
+}
+
+std::string CoordinateText(const nlohmann::json& v) {
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_number()) return Num(v.get<double>());
+  if (v.is_array() && v.size() == 3) {
+    return "(" + Short(v[0].get<double>()) + ", " + Short(v[1].get<double>()) + ", " + Short(v[2].get<double>()) + ")";
+  }
+  return v.dump();
+}
+
+std::vector<Done> ReadPoints(const SweepContext& sweep, std::vector<int>* missing) {
+  std::vector<Done> out;
+  for (int i = 0, n = PointCount(sweep.spec); i < n; ++i) {
+    const fs::path file = PointFile(sweep, i);
+    if (!fs::is_regular_file(file)) {
+      missing->push_back(i);
+      continue;
+    }
+    const JsonNode root = ParseJsonFile(file.string());
+    if (root.GetString("format") != "irbench.sweep-point/1") root["format"].Fail("expected \"irbench.sweep-point/1\"");
+    if (root.GetString("sweep") != sweep.spec.name) root["sweep"].Fail("a point of another sweep");
+    if (root.GetInt("index") != i) root["index"].Fail("expected " + std::to_string(i));
+    Done d;
+    d.index = i;
+    d.point = PointAt(sweep.spec, i);
+    d.coordinates = root["coordinates"].raw();
+    const JsonNode metrics = root["metrics"];
+    for (const std::string& key : metrics.Keys()) d.metrics[key] = metrics[key].Number();
+    d.report = root.GetString("report", "");
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+// Best first by the spec's metric; points without it last, by index.
+void Rank(const SweepSpec& spec, std::vector<Done>* points) {
+  const bool higher = HigherIsBetter(spec.metric);
+  std::stable_sort(points->begin(), points->end(), [&](const Done& a, const Done& b) {
+    const auto ia = a.metrics.find(spec.metric), ib = b.metrics.find(spec.metric);
+    if (ia == a.metrics.end() || ib == b.metrics.end()) return ia != a.metrics.end() && ib == b.metrics.end();
+    return higher ? ia->second > ib->second : ia->second < ib->second;
+  });
+}
+
+std::vector<std::string> MetricColumns(const std::vector<Done>& points) {
+  std::vector<std::string> out;
+  for (const std::string& m : KnownMetrics()) {
+    for (const Done& d : points) {
+      if (d.metrics.count(m)) {
+        out.push_back(m);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const std::vector<std::string>& metrics) {
+  std::ostringstream out;
+  out << "point";
+  for (const SweepAxis& axis : spec.axes) {
+    if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+      for (const char* c : {".along", ".height", ".x", ".y", ".z"}) out << "," << axis.name << c;
+    } else {
+      out << "," << axis.name;
+    }
+  }
+  for (const std::string& m : metrics) out << "," << m;
+  out << "\n";
+  for (const Done& d : points) {
+    out << d.index;
+    for (size_t k = 0; k < spec.axes.size(); ++k) {
+      const AxisValue& at = d.point.at[k];
+      if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
+        out << "," << Num(at.along) << "," << Num(at.height) << "," << Num(at.position.x()) << ","
+            << Num(at.position.y()) << "," << Num(at.position.z());
+      } else {
+        std::string v = CoordinateText(at.value);
+        if (v.find_first_of(",\"") != std::string::npos) v = "\"" + v + "\"";  // (no quotes in names)
+        out << "," << v;
+      }
+    }
+    for (const std::string& m : metrics) {
+      const auto it = d.metrics.find(m);
+      out << "," << (it == d.metrics.end() ? "" : Num(it->second));
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+std::string Value(const Done& d, const std::string& metric) {
+  const auto it = d.metrics.find(metric);
+  return it == d.metrics.end() ? "–" : Short(it->second);
+}
+
+// Markdown: the points best first.
+std::string RankTable(const SweepSpec& spec, const std::vector<Done>& ranked) {
+  std::vector<std::string> shown = {spec.metric};
+  for (const char* m : {"arms_mean_cm", "root_mean_cm", "tracked_fraction", "silhouette_iou_median"}) {
+    if (m != spec.metric) shown.push_back(m);
+  }
+  std::ostringstream out;
+  out << "| rank | point |";
+  for (const SweepAxis& axis : spec.axes) out << " " << axis.name << " |";
+  for (const std::string& m : shown) out << " " << m << " |";
+  out << "\n|---|---|";
+  for (size_t k = 0; k < spec.axes.size() + shown.size(); ++k) out << "---|";
+  out << "\n";
+  for (size_t r = 0; r < ranked.size(); ++r) {
+    const Done& d = ranked[r];
+    out << "| " << r + 1 << " | " << PointName(d.index) << " |";
+    for (size_t k = 0; k < spec.axes.size(); ++k) {
+      const AxisValue& at = d.point.at[k];
+      const bool placed = std::holds_alternative<PlacementAxis>(spec.axes[k].axis);
+      out << " " << (placed ? CoordinateText(nlohmann::json{at.position.x(), at.position.y(), at.position.z()})
+                            : CoordinateText(at.value))
+          << " |";
+    }
+    for (const std::string& m : shown) out << " " << Value(d, m) << " |";
+    out << "\n";
+  }
+  return out.str();
+}
+
+// Markdown: per axis, the metric's mean over the points at each of its values.
+std::string AxisTables(const SweepSpec& spec, const std::vector<Done>& points) {
+  std::ostringstream out;
+  for (size_t k = 0; k < spec.axes.size(); ++k) {
+    const SweepAxis& axis = spec.axes[k];
+    std::map<std::string, std::pair<double, int>> by;  // value -> (sum, count)
+    std::vector<std::string> order;
+    const auto add = [&](const std::string& key, const Done& d) {
+      const auto it = d.metrics.find(spec.metric);
+      if (it == d.metrics.end()) return;
+      if (!by.count(key)) order.push_back(key);
+      by[key].first += it->second;
+      ++by[key].second;
+    };
+    const bool placed = std::holds_alternative<PlacementAxis>(axis.axis);
+    if (placed && spec.mode == "random") continue;  // continuous: the heat map shows it
+    for (const Done& d : points) {
+      const AxisValue& at = d.point.at[k];
+      add(placed ? "height " + Short(at.height) + " m, along " + Short(at.along) : CoordinateText(at.value), d);
+    }
+    out << "\n### " << axis.name << "\n\n| " << (placed ? "placement" : axis.name) << " | points | mean "
+        << spec.metric << " |\n|---|---|---|\n";
+    for (const std::string& key : order) {
+      out << "| " << key << " | " << by[key].second << " | " << Short(by[key].first / by[key].second) << " |\n";
+    }
+  }
+  return out.str();
+}
+
+// An SVG heat map of one placement axis: the metric (mean over the other
+// axes) at each position along the line and height; green best, red worst.
+std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& points) {
+  const auto& p = std::get<PlacementAxis>(spec.axes[k].axis);
+  struct Cell {
+    double along, height, sum = 0;
+    int n = 0;
+  };
+  std::map<std::pair<long, long>, Cell> cells;
+  for (const Done& d : points) {
+    const auto it = d.metrics.find(spec.metric);
+    if (it == d.metrics.end()) continue;
+    const AxisValue& at = d.point.at[k];
+    const std::pair<long, long> key = spec.mode == "grid" ? std::make_pair(long(at.along_step), long(at.height_step))
+                                                            : std::make_pair(long(d.index), 0L);
+    Cell& c = cells.try_emplace(key, Cell{at.along, at.height}).first->second;
+    c.sum += it->second;
+    ++c.n;
+  }
+  if (cells.empty()) return "";
+  double lo = 1e300, hi = -1e300;
+  for (const auto& [key, c] : cells) {
+    lo = std::min(lo, c.sum / c.n);
+    hi = std::max(hi, c.sum / c.n);
+  }
+  const bool higher = HigherIsBetter(spec.metric);
+  const double w = 480, h = 240, left = 60, top = 20, bottom = 50;
+  const double hmin = std::min(p.height.from, p.height.to), hmax = std::max(p.height.from, p.height.to);
+  const int cols = spec.mode == "grid" ? p.steps : 1, rows = spec.mode == "grid" ? p.height.steps : 1;
+  std::ostringstream svg;
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << left + w + 20 << "\" height=\"" << top + h + bottom
+      << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
+  for (const auto& [key, c] : cells) {
+    const double v = c.sum / c.n;
+    const double bad = hi > lo ? (higher ? (hi - v) / (hi - lo) : (v - lo) / (hi - lo)) : 0.0;
+    char colour[32];
+    std::snprintf(colour, sizeof(colour), "rgb(%d,%d,70)", int(40 + 200 * bad), int(190 - 150 * bad));
+    const double fx = c.along, fy = hmax > hmin ? (c.height - hmin) / (hmax - hmin) : 0.5;
+    if (spec.mode == "grid") {
+      const double cw = w / cols, ch = h / rows;
+      const double x = left + (cols > 1 ? fx * (cols - 1) : 0) * cw, y = top + h - ch - (rows > 1 ? fy * (rows - 1) : 0) * ch;
+      svg << "<rect x=\"" << x << "\" y=\"" << y << "\" width=\"" << cw - 1 << "\" height=\"" << ch - 1
+          << "\" fill=\"" << colour << "\"/><text x=\"" << x + cw / 2 << "\" y=\"" << y + ch / 2 + 4
+          << "\" text-anchor=\"middle\" fill=\"white\">" << Short(v) << "</text>\n";
+    } else {
+      svg << "<circle cx=\"" << left + fx * w << "\" cy=\"" << top + h - fy * h << "\" r=\"7\" fill=\"" << colour
+          << "\"><title>" << Short(v) << "</title></circle>\n";
+    }
+  }
+  const Eigen::Vector3d a = {p.from.x(), p.from.y(), 0}, b = {p.to.x(), p.to.y(), 0};
+  svg << "<text x=\"" << left << "\" y=\"" << top + h + 18 << "\">along: x, y = (" << Short(a.x()) << ", "
+      << Short(a.y()) << ")</text><text x=\"" << left + w << "\" y=\"" << top + h + 18
+      << "\" text-anchor=\"end\">(" << Short(b.x()) << ", " << Short(b.y()) << ")</text>\n"
+      << "<text x=\"" << left + w / 2 << "\" y=\"" << top + h + 38 << "\" text-anchor=\"middle\">camera " << p.camera
+      << ": " << spec.metric << " (green best: " << Short(higher ? hi : lo) << ", red worst: "
+      << Short(higher ? lo : hi) << ")</text>\n"
+      << "<text x=\"" << left - 6 << "\" y=\"" << top + h << "\" text-anchor=\"end\">" << Short(hmin)
+      << " m</text><text x=\"" << left - 6 << "\" y=\"" << top + 10 << "\" text-anchor=\"end\">" << Short(hmax)
+      << " m</text>\n</svg>\n";
+  return svg.str();
+}
+
+// How to render, track and score the best point alone.
+std::string ReproduceText(const SweepContext& sweep, const Done& best) {
+  const Scenario sc = PointScenario(sweep.spec, best.point, sweep.out / "rigs");
+  const RenderJobOptions& r = sc.render;
+  std::ostringstream out;
+  out << "irbench render --rig " << r.rig << (r.scene.empty() ? "" : " --scene " + r.scene) << " --avatar "
+      << r.avatar << " --motion " << r.motion << " --sensor " << r.sensor << " --seed " << r.seed
+      << (r.frames ? " --frames " + std::to_string(*r.frames) : std::string()) << " --background-frames "
+      << r.background_frames << " --out best && irbench track best && irbench score best";
+  return out.str();
+}
+
+}  // namespace
+
+SweepCollected CollectSweep(const SweepOptions& options) {
+  const SweepContext sweep = OpenSweep(options);
+  const SweepSpec& spec = sweep.spec;
+  SweepCollected out;
+  out.total = PointCount(spec);
+  std::vector<Done> points = ReadPoints(sweep, &out.missing);
+  out.done = static_cast<int>(points.size());
+  const std::vector<std::string> metrics = MetricColumns(points);
+  out.csv = sweep.out / "sweep.csv";
+  AtomicWriteFile(out.csv, Csv(spec, points, metrics));
+  std::vector<Done> ranked = points;
+  Rank(spec, &ranked);
+  std::ostringstream md;
+  md << "# sweep " << spec.name << "\n\n" << spec.description << "\n\n" << out.done << " of " << out.total
+     << " points done (mode " << spec.mode << "), ranked by " << spec.metric << " ("
+     << (HigherIsBetter(spec.metric) ? "higher" : "lower") << " is better).\n";
+  if (!out.missing.empty()) {
+    md << "Not done: " << out.missing.size() << " point(s); `irbench sweep run` or `submit` again runs only them.\n";
+  }
+  std::string best_text;
+  if (!ranked.empty() && ranked.front().metrics.count(spec.metric)) {
+    const Done& best = ranked.front();
+    out.best = best.index;
+    best_text = "## Best: " + PointName(best.index) + ", " + spec.metric + " " + Short(best.metrics.at(spec.metric)) +
+                "\n\nAt " + best.coordinates.dump() + ".\n\nAlone: `" + ReproduceText(sweep, best) + "`\n";
+    md << "\n" << best_text;
+  }
+  const std::string rank_table = RankTable(spec, ranked), axis_tables = AxisTables(spec, points);
+  md << "\n## Points, best first\n\n" << rank_table << "\n## " << spec.metric << " by axis\n" << axis_tables;
+  out.md = sweep.out / "sweep.md";
+  AtomicWriteFile(out.md, md.str());
+  std::ostringstream html;
+  html << "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>sweep " << HtmlEscape(spec.name)
+       << "</title><style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;margin:1em 0}"
+          "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}th{background:#eee}</style></head><body>\n"
+       << "<h1>sweep " << HtmlEscape(spec.name) << "</h1>\n<p>" << HtmlEscape(spec.description) << "</p>\n<p>"
+       << out.done << " of " << out.total << " points done; ranked by " << HtmlEscape(spec.metric) << ".</p>\n";
+  if (out.best) {
+    html << "<h2>Best: " << PointName(*out.best) << "</h2>\n<p><code>" << HtmlEscape(ReproduceText(sweep, ranked.front()))
+         << "</code></p>\n";
+  }
+  for (size_t k = 0; k < spec.axes.size(); ++k) {
+    if (!std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) continue;
+    html << "<h2>Placement of " << HtmlEscape(spec.axes[k].name) << "</h2>\n" << HeatMap(spec, k, points);
+  }
+  html << "<h2>Points, best first</h2>\n" << MarkdownTableHtml(rank_table) << "<h2>" << HtmlEscape(spec.metric)
+       << " by axis</h2>\n" << MarkdownTableHtml(axis_tables) << "<h2>Each point's report, worst first</h2>\n<ul>\n";
+  for (auto it = ranked.rbegin(); it != ranked.rend(); ++it) {
+    if (it->report.empty()) continue;
+    const std::string link = fs::relative(sweep.cache / it->report, sweep.out).generic_string();
+    html << "<li><a href=\"" << HtmlEscape(link) << "\">" << PointName(it->index) << "</a> " << HtmlEscape(spec.metric)
+         << " " << Value(*it, spec.metric) << "</li>\n";
+  }
+  html << "</ul>\n</body></html>\n";
+  out.html = sweep.out / "report.html";
+  AtomicWriteFile(out.html, html.str());
+  return out;
+}
+
+}  // namespace irbench

@@ -1,0 +1,352 @@
+#include "ci/sweep/sweep_spec.h"
+
+#include <cmath>
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <set>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/json_reader.h"
+#include "common/paths.h"
+#include "sequence_format/calibration.h"
+#include "sim/camera/rig.h"
+#include "sim/scene/mesh.h"
+
+namespace irbench {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr int kMaxSteps = 1000;
+constexpr int kMaxPoints = 1000000;
+
+// The scenario keys a value axis may take; `track.<setting>` as well.
+const std::vector<std::string>& ValueKeys() {
+  static const std::vector<std::string> keys = {"scene", "rig", "avatar", "motion", "sensor",
+                                                "seed", "frames", "background_frames"};
+  return keys;
+}
+
+int CheckSteps(const JsonNode& node) {
+  const int steps = node.Int();
+  if (steps < 1 || steps > kMaxSteps) node.Fail("must be in 1.." + std::to_string(kMaxSteps));
+  return steps;
+}
+
+// `{"from": a, "to": b, "steps": n}` or one number (one step).
+SweepRange ReadRange(const JsonNode& node) {
+  SweepRange range;
+  if (node.raw().is_number()) {
+    range.from = range.to = node.Number();
+    return range;
+  }
+  node.CheckKeys({"from", "to", "steps"});
+  range.from = node.GetDouble("from");
+  range.to = node.GetDouble("to");
+  range.steps = CheckSteps(node["steps"]);
+  if (!std::isfinite(range.from) || !std::isfinite(range.to)) node.Fail("from and to must be finite");
+  if (range.steps > 1 && range.from == range.to) node.Fail("an empty range: from equals to with several steps");
+  return range;
+}
+
+PlacementAxis ReadPlacement(const JsonNode& a) {
+  a.CheckKeys({"camera", "along", "height", "look_at", "up"});
+  PlacementAxis p;
+  p.camera = a.GetString("camera");
+  const JsonNode along = a["along"];
+  along.CheckKeys({"from", "to", "steps"});
+  p.from = along["from"].Vec2();
+  p.to = along["to"].Vec2();
+  p.steps = along.Has("steps") ? CheckSteps(along["steps"]) : 1;
+  if (p.steps > 1 && (p.from - p.to).norm() < 1e-9) along.Fail("an empty range: from equals to with several steps");
+  p.height = ReadRange(a["height"]);
+  if (a.Has("look_at")) p.look_at = a["look_at"].Vec3();
+  if (a.Has("up")) {
+    p.has_up = true;
+    p.up = a["up"].Vec3();
+  }
+  return p;
+}
+
+// The spec's base scenario with `key` set to `value` ("track.x": the track
+// object's x).
+nlohmann::json WithValue(nlohmann::json base, const std::string& key, const nlohmann::json& value) {
+  if (key.rfind("track.", 0) == 0) {
+    base["track"][key.substr(6)] = value;
+  } else {
+    base[key] = value;
+  }
+  return base;
+}
+
+Scenario ScenarioOf(const nlohmann::json& keys, const fs::path& file) {
+  const JsonNode node = ParseJsonString(keys.dump(), file.string());
+  Scenario sc;
+  ReadScenarioKeys(node, file, &sc);
+  return sc;
+}
+
+// The rig file and the scene's bounds for a scenario.
+struct RigPlace {
+  fs::path rig_file;
+  Rig rig;
+  Eigen::Vector3d lo, hi;
+  std::string scene;
+};
+
+RigPlace PlaceOf(const Scenario& sc) {
+  const RenderInputs in = LoadRenderInputs(sc.render);
+  RigPlace out;
+  out.rig_file = in.rig_file;
+  out.rig = in.rig;
+  out.scene = in.scene.name;
+  out.lo = Eigen::Vector3d::Constant(1e30);
+  out.hi = Eigen::Vector3d::Constant(-1e30);
+  for (const MeshVertex& v : in.scene.mesh.vertices) {
+    const Eigen::Vector3d p = v.position.cast<double>();
+    out.lo = out.lo.cwiseMin(p);
+    out.hi = out.hi.cwiseMax(p);
+  }
+  return out;
+}
+
+Eigen::Vector3d PlacementPosition(const PlacementAxis& p, double along, double height) {
+  const Eigen::Vector2d xy = p.from + along * (p.to - p.from);
+  return {xy.x(), xy.y(), height};
+}
+
+std::string Vec(const Eigen::Vector3d& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "(%.3g, %.3g, %.3g)", v.x(), v.y(), v.z());
+  return buf;
+}
+
+// Every corner of a placement inside the scene's bounds, the camera in the rig.
+void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& place) {
+  bool found = false;
+  for (const Camera& c : place.rig.cameras) found |= c.name == p.camera;
+  if (!found) {
+    std::string names;
+    for (const Camera& c : place.rig.cameras) names += (names.empty() ? "" : ", ") + c.name;
+    a["camera"].Fail("no camera '" + p.camera + "' in rig " + place.rig.name + " (" + names + ")");
+  }
+  for (const double along : {0.0, 1.0}) {
+    for (const double height : {p.height.from, p.height.to}) {
+      const Eigen::Vector3d at = PlacementPosition(p, along, height);
+      if ((at.array() <= place.lo.array()).any() || (at.array() >= place.hi.array()).any()) {
+        a["along"].Fail("camera at " + Vec(at) + " lies outside the scene '" + place.scene +
+                                                "' " + Vec(place.lo) + " to " + Vec(place.hi));
+      }
+      if ((at - p.look_at).norm() < 1e-6) a["look_at"].Fail("the camera at " + Vec(at) + " is at its look_at");
+    }
+  }
+}
+
+uint64_t Mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// A uniform number in [0, 1) from (seed, index, axis, which): the same point
+// whoever draws it, in any order.
+double Uniform(uint64_t seed, int index, size_t axis, int which) {
+  const uint64_t h = Mix(Mix(Mix(Mix(seed) ^ uint64_t(index)) ^ uint64_t(axis)) ^ uint64_t(which));
+  return double(h >> 11) * (1.0 / 9007199254740992.0);
+}
+
+size_t AxisSize(const SweepAxis& axis) {
+  if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) return size_t(p->steps) * p->height.steps;
+  return std::get<ValueAxis>(axis.axis).values.size();
+}
+
+}  // namespace
+
+std::string PointName(int index) {
+  char buf[24];
+  std::snprintf(buf, sizeof(buf), "p%04d", index);
+  return buf;
+}
+
+SweepSpec LoadSweepSpec(const fs::path& file) {
+  const JsonNode root = ParseJsonFile(file.string());
+  root.CheckKeys({"format", "name", "description", "base", "axes", "mode", "samples", "seed", "metric"});
+  if (root.GetString("format") != "irbench.sweep/1") root["format"].Fail("expected \"irbench.sweep/1\"");
+  SweepSpec spec;
+  spec.file = file;
+  spec.name = root.GetString("name");
+  if (const std::string problem = CameraNameProblem(spec.name); !problem.empty()) root["name"].Fail(problem);
+  spec.description = root.GetString("description", "");
+  const JsonNode base = root["base"];
+  base.CheckKeys(ScenarioKeys());
+  if (base.Has("optional")) base["optional"].Fail("a sweep's base is not optional");
+  spec.base = base.raw();
+  const Scenario base_scenario = ScenarioOf(spec.base, file);  // checks the base's keys
+  spec.inputs = ScenarioInputFiles(base_scenario.render);       // and its files
+  spec.mode = root.GetString("mode", "grid");
+  if (spec.mode != "grid" && spec.mode != "random") root["mode"].Fail("expected \"grid\" or \"random\"");
+  if (spec.mode == "random") {
+    spec.samples = root.GetInt("samples");
+    if (spec.samples < 1 || spec.samples > kMaxPoints) root["samples"].Fail("must be in 1..1000000");
+    spec.seed = static_cast<uint64_t>(root.GetInt("seed", 1));
+  } else if (root.Has("samples")) {
+    root["samples"].Fail("only for mode \"random\"");
+  }
+  spec.metric = root.GetString("metric", "arms_mean_cm");
+  const auto& metrics = KnownMetrics();
+  if (std::find(metrics.begin(), metrics.end(), spec.metric) == metrics.end()) {
+    root["metric"].Fail("unknown metric (" + KnownMetricsText() + ")");
+  }
+  const JsonNode axes = root["axes"];
+  if (axes.Size() == 0) axes.Fail("no axes");
+  std::set<std::string> names;
+  std::vector<nlohmann::json> rigs = {spec.base.value("rig", std::string("theater4"))};
+  // Value axes first: a placement is checked against every rig a point may have.
+  for (size_t i = 0; i < axes.Size(); ++i) {
+    const JsonNode a = axes[i];
+    if (a.Has("camera")) continue;
+    a.CheckKeys({"key", "values"});
+    ValueAxis v;
+    v.key = a.GetString("key");
+    const bool track_key = v.key.rfind("track.", 0) == 0 && v.key.size() > 6;
+    if (!track_key && std::find(ValueKeys().begin(), ValueKeys().end(), v.key) == ValueKeys().end()) {
+      a["key"].Fail("not a key a sweep can vary (scene, rig, avatar, motion, sensor, seed, frames, "
+                    "background_frames, track.<setting>)");
+    }
+    if (!names.insert(v.key).second) a["key"].Fail("'" + v.key + "' is swept twice");
+    const JsonNode values = a["values"];
+    if (values.Size() == 0) values.Fail("an empty list");
+    for (size_t j = 0; j < values.Size(); ++j) {
+      v.values.push_back(values[j].raw());
+      try {
+        for (const fs::path& f : ScenarioInputFiles(ScenarioOf(WithValue(spec.base, v.key, values[j].raw()), file).render)) {
+          spec.inputs.push_back(f);
+        }
+      } catch (const InputError& e) {
+        values[j].Fail(e.message());
+      }
+    }
+    if (v.key == "rig") rigs = v.values;
+    spec.axes.push_back({v.key, v});
+  }
+  std::vector<SweepAxis> placements;
+  for (size_t i = 0; i < axes.Size(); ++i) {
+    const JsonNode a = axes[i];
+    if (!a.Has("camera")) continue;
+    PlacementAxis p = ReadPlacement(a);
+    if (!names.insert(p.camera).second) a["camera"].Fail("camera '" + p.camera + "' is placed twice");
+    for (const nlohmann::json& rig : rigs) CheckPlacement(a, p, PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), file)));
+    placements.push_back({p.camera, p});
+  }
+  // Placements first in the point order, as written.
+  spec.axes.insert(spec.axes.begin(), placements.begin(), placements.end());
+  double count = spec.mode == "random" ? spec.samples : 1;
+  if (spec.mode == "grid") {
+    for (const SweepAxis& axis : spec.axes) count *= double(AxisSize(axis));
+  }
+  if (count > kMaxPoints) axes.Fail("a grid of " + std::to_string(count) + " points (at most 1000000)");
+  spec.canonical = root.raw().dump(2) + "\n";
+  return spec;
+}
+
+int PointCount(const SweepSpec& spec) {
+  if (spec.mode == "random") return spec.samples;
+  size_t count = 1;
+  for (const SweepAxis& axis : spec.axes) count *= AxisSize(axis);
+  return static_cast<int>(count);
+}
+
+SweepPoint PointAt(const SweepSpec& spec, int index) {
+  if (index < 0 || index >= PointCount(spec)) {
+    throw InputError(spec.file.string(), "INDEX",
+                     "point " + std::to_string(index) + " of 0.." + std::to_string(PointCount(spec) - 1));
+  }
+  SweepPoint point;
+  point.index = index;
+  point.at.resize(spec.axes.size());
+  size_t rest = static_cast<size_t>(index);
+  for (size_t k = spec.axes.size(); k-- > 0;) {
+    const SweepAxis& axis = spec.axes[k];
+    AxisValue& at = point.at[k];
+    size_t cell = 0;
+    const bool grid = spec.mode == "grid";
+    if (grid) {
+      cell = rest % AxisSize(axis);
+      rest /= AxisSize(axis);
+    }
+    if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
+      if (grid) {
+        at.along_step = static_cast<int>(cell % p->steps);
+        at.height_step = static_cast<int>(cell / p->steps);
+        at.along = p->steps <= 1 ? 0.0 : double(at.along_step) / (p->steps - 1);
+        at.height = p->height.At(at.height_step);
+      } else {
+        at.along = Uniform(spec.seed, index, k, 0);
+        at.height = p->height.from + (p->height.to - p->height.from) * Uniform(spec.seed, index, k, 1);
+      }
+      at.position = PlacementPosition(*p, at.along, at.height);
+    } else {
+      const ValueAxis& v = std::get<ValueAxis>(axis.axis);
+      if (!grid) cell = std::min(v.values.size() - 1, size_t(Uniform(spec.seed, index, k, 0) * v.values.size()));
+      at.value = v.values[cell];
+    }
+  }
+  return point;
+}
+
+nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point) {
+  nlohmann::json out = nlohmann::json::object();
+  for (size_t k = 0; k < spec.axes.size(); ++k) {
+    const SweepAxis& axis = spec.axes[k];
+    const AxisValue& at = point.at[k];
+    if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+      out[axis.name + ".along"] = at.along;
+      out[axis.name + ".height"] = at.height;
+      out[axis.name + ".position"] = {at.position.x(), at.position.y(), at.position.z()};
+    } else {
+      out[axis.name] = at.value;
+    }
+  }
+  return out;
+}
+
+Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs::path& rigs) {
+  nlohmann::json keys = spec.base;
+  bool moved = false;
+  for (size_t k = 0; k < spec.axes.size(); ++k) {
+    if (const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis)) keys = WithValue(keys, v->key, point.at[k].value);
+    moved |= std::holds_alternative<PlacementAxis>(spec.axes[k].axis);
+  }
+  if (moved) {
+    // The point's rig: the base rig's file with the placed cameras moved.
+    const Scenario unmoved = ScenarioOf(keys, spec.file);
+    const fs::path rig_file = LoadRenderInputs(unmoved.render).rig_file;
+    std::ifstream in(rig_file);
+    nlohmann::json rig = nlohmann::json::parse(in);
+    rig["name"] = rig.value("name", rig_file.stem().string()) + "-" + spec.name + "-" + PointName(point.index);
+    rig["description"] = "Sweep " + spec.name + " point " + std::to_string(point.index) + " of " +
+                         rig_file.filename().string() + ": " + PointCoordinates(spec, point).dump();
+    for (size_t k = 0; k < spec.axes.size(); ++k) {
+      const auto* p = std::get_if<PlacementAxis>(&spec.axes[k].axis);
+      if (!p) continue;
+      for (nlohmann::json& camera : rig["cameras"]) {
+        if (camera.value("name", "") != p->camera) continue;
+        const Eigen::Vector3d& at = point.at[k].position;
+        camera["position"] = {at.x(), at.y(), at.z()};
+        camera["look_at"] = {p->look_at.x(), p->look_at.y(), p->look_at.z()};
+        if (p->has_up) camera["up"] = {p->up.x(), p->up.y(), p->up.z()};
+      }
+    }
+    fs::create_directories(rigs);
+    const fs::path file = fs::absolute(rigs / (PointName(point.index) + ".json"));
+    AtomicWriteFile(file, rig.dump(2) + "\n");
+    keys["rig"] = file.string();
+  }
+  Scenario sc = ScenarioOf(keys, spec.file);
+  sc.name = spec.name + "-" + PointName(point.index);
+  return sc;
+}
+
+}  // namespace irbench

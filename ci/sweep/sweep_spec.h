@@ -1,0 +1,101 @@
+#pragma once
+// A sweep spec (irbench.sweep/1, docs/sweeps.md): a base scenario in a
+// suite's terms, axes — camera placements along a wall or ceiling line and
+// over heights, or lists of values for a scenario key (rig, avatar, motion,
+// sensor, seed, frames, track.<setting>) — and a mode: `grid` (every
+// combination) or seeded `random` samples. Points are numbered; a point's
+// coordinates depend only on the spec and its index, so any process (a local
+// worker, a Slurm array task) can run point i alone.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "ci/suite_runner/scenario.h"
+
+namespace irbench {
+
+// `from` to `to` in `steps` even steps, both ends included (steps 1: `from`).
+struct SweepRange {
+  double from = 0, to = 0;
+  int steps = 1;
+  double At(int step) const { return steps <= 1 ? from : from + (to - from) * step / (steps - 1); }
+};
+
+// One camera moved along a line on a wall or the ceiling (x, y in metres, at
+// each height), aimed at `look_at`.
+struct PlacementAxis {
+  std::string camera;
+  Eigen::Vector2d from = Eigen::Vector2d::Zero(), to = Eigen::Vector2d::Zero();
+  int steps = 1;  // positions along the line
+  SweepRange height;
+  Eigen::Vector3d look_at = Eigen::Vector3d(0, 0, 1);
+  bool has_up = false;
+  Eigen::Vector3d up = Eigen::Vector3d(0, 0, 1);
+};
+
+// A scenario key (`rig`, `motion`, `track.rest_model` ...) taking each value.
+struct ValueAxis {
+  std::string key;
+  std::vector<nlohmann::json> values;
+};
+
+struct SweepAxis {
+  std::string name;  // the camera's name or the key
+  std::variant<PlacementAxis, ValueAxis> axis;
+};
+
+struct SweepSpec {
+  std::string name, description;
+  std::filesystem::path file;
+  nlohmann::json base;  // the base scenario's keys as written
+  std::vector<SweepAxis> axes;
+  std::string mode = "grid";  // grid | random
+  int samples = 0;            // random: points
+  uint64_t seed = 1;          // random: the sampler's seed
+  std::string metric = "arms_mean_cm";  // ranks the points (KnownMetrics())
+  std::vector<std::filesystem::path> inputs;  // the data files the points read (rigs, avatars, motions ...)
+  std::string canonical;  // the spec as parsed, one JSON text: what OUT/spec.json holds
+};
+
+// Where a point sits on one axis.
+struct AxisValue {
+  double along = 0;   // placement: 0..1 from `from` to `to`
+  double height = 0;  // placement: metres
+  int along_step = -1, height_step = -1;  // grid: the steps; random: -1
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  nlohmann::json value;  // value axis
+};
+
+struct SweepPoint {
+  int index = 0;
+  std::vector<AxisValue> at;  // per axis
+};
+
+// Reads and checks a spec: every field named in errors (InputError), every
+// value axis's values and every placement's corners tried against the scene
+// (a camera outside the scene's bounds, an unknown camera, an empty range).
+SweepSpec LoadSweepSpec(const std::filesystem::path& file);
+
+// grid: the product of the axes' sizes; random: `samples`.
+int PointCount(const SweepSpec& spec);
+
+// Point `index` (0 <= index < PointCount): grid in row-major order over the
+// axes (the last axis fastest); random from a hash of (seed, index, axis).
+SweepPoint PointAt(const SweepSpec& spec, int index);
+
+// {"<camera>.along": .., "<camera>.height": .., "<camera>.position": [x,y,z],
+// "<key>": value, ...}
+nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point);
+
+// The point's scenario: the base with the point's values; a placement writes
+// the moved rig to <rigs>/pNNNN.json (that file renders the point alone).
+Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const std::filesystem::path& rigs);
+
+// "p0007"
+std::string PointName(int index);
+
+}  // namespace irbench

@@ -1,0 +1,151 @@
+// The sweep spec: its points against a brute-force enumeration and the
+// analytic placements, the moved rig's camera where the point says, random
+// points reproducible by index, and bad specs refused naming the field.
+
+#include "ci/sweep/sweep_spec.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <tuple>
+
+#include "common/error.h"
+#include "sim/camera/rig.h"
+
+namespace irbench {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path Dir() {
+  const fs::path dir = fs::temp_directory_path() / "irbench_sweep_spec_test";
+  fs::create_directories(dir);
+  return dir;
+}
+
+fs::path Write(const std::string& name, const std::string& text) {
+  const fs::path file = Dir() / name;
+  std::ofstream(file) << text;
+  return file;
+}
+
+// A spec with the side camera on a 3 x 2 placement grid and two persons.
+std::string GridSpec(const std::string& extra = "") {
+  return R"({"format": "irbench.sweep/1", "name": "t", "base": {"rig": "theater4", "motion": "wave", "frames": 3},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -1.0], "to": [-3.6, 2.0], "steps": 3},
+              "height": {"from": 1.5, "to": 2.5, "steps": 2}, "look_at": [0, 0, 1.1]},
+             {"key": "avatar", "values": ["p1", "p4"]}])" + extra + "}";
+}
+
+TEST(SweepSpecTest, GridVisitsEveryCombinationOnceAtTheAnalyticPlaces) {
+  const SweepSpec spec = LoadSweepSpec(Write("grid.json", GridSpec()));
+  ASSERT_EQ(PointCount(spec), 3 * 2 * 2);
+  std::set<std::tuple<int, int, std::string>> seen;
+  for (int i = 0; i < PointCount(spec); ++i) {
+    const SweepPoint p = PointAt(spec, i);
+    ASSERT_EQ(p.at.size(), 2u);
+    const AxisValue& place = p.at[0];
+    seen.insert({place.along_step, place.height_step, p.at[1].value.get<std::string>()});
+    // from + t (to - from), t = step / 2; heights 1.5 and 2.5.
+    EXPECT_NEAR(place.position.x(), -3.6, 1e-12);
+    EXPECT_NEAR(place.position.y(), -1.0 + 3.0 * place.along_step / 2.0, 1e-12);
+    EXPECT_NEAR(place.position.z(), place.height_step == 0 ? 1.5 : 2.5, 1e-12);
+  }
+  EXPECT_EQ(seen.size(), 12u);  // every combination, none twice
+  // The last axis changes fastest.
+  EXPECT_EQ(PointAt(spec, 0).at[1].value, "p1");
+  EXPECT_EQ(PointAt(spec, 1).at[1].value, "p4");
+  EXPECT_THROW(PointAt(spec, 12), InputError);
+}
+
+TEST(SweepSpecTest, PointRigHasTheCameraWhereThePointSays) {
+  const SweepSpec spec = LoadSweepSpec(Write("rig.json", GridSpec()));
+  const SweepPoint p = PointAt(spec, 7);
+  const Scenario sc = PointScenario(spec, p, Dir() / "rigs");
+  EXPECT_EQ(sc.render.avatar, p.at[1].value.get<std::string>());
+  EXPECT_EQ(fs::path(sc.render.rig).filename(), "p0007.json");
+  const Rig moved = LoadRig(sc.render.rig);
+  const Rig base = LoadRig(fs::path(IRBENCH_SOURCE_DIR) / "rigs" / "theater4.json");
+  ASSERT_EQ(moved.cameras.size(), base.cameras.size());
+  for (size_t c = 0; c < moved.cameras.size(); ++c) {
+    const Eigen::Vector3d centre = moved.cameras[c].cam_from_world.inverse().translation();
+    const Eigen::Vector3d base_centre = base.cameras[c].cam_from_world.inverse().translation();
+    if (moved.cameras[c].name == "side") {
+      EXPECT_LT((centre - p.at[0].position).norm(), 1e-9);
+      // Aimed at look_at: the optical axis (camera z) points at it.
+      const Eigen::Vector3d axis = moved.cameras[c].cam_from_world.linear().row(2).transpose();
+      EXPECT_GT(axis.dot((Eigen::Vector3d(0, 0, 1.1) - centre).normalized()), 1 - 1e-9);
+    } else {
+      EXPECT_LT((centre - base_centre).norm(), 1e-9) << moved.cameras[c].name;
+    }
+  }
+}
+
+TEST(SweepSpecTest, RandomPointsAreInRangeAndDependOnlyOnSeedAndIndex) {
+  const std::string text = R"({"format": "irbench.sweep/1", "name": "r", "mode": "random", "samples": 50, "seed": 9,
+    "base": {"rig": "theater4", "motion": "wave", "frames": 3},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -1.0], "to": [-3.6, 2.0]},
+              "height": {"from": 1.5, "to": 2.5, "steps": 2}}, {"key": "seed", "values": [1, 2, 3]}]})";
+  const SweepSpec a = LoadSweepSpec(Write("r1.json", text));
+  ASSERT_EQ(PointCount(a), 50);
+  std::set<int> seeds;
+  double mean_along = 0;
+  for (int i = 0; i < 50; ++i) {
+    const SweepPoint p = PointAt(a, i);
+    EXPECT_GE(p.at[0].along, 0.0);
+    EXPECT_LT(p.at[0].along, 1.0);
+    EXPECT_GE(p.at[0].height, 1.5);
+    EXPECT_LE(p.at[0].height, 2.5);
+    mean_along += p.at[0].along / 50;
+    seeds.insert(p.at[1].value.get<int>());
+    EXPECT_EQ(PointCoordinates(a, p), PointCoordinates(a, PointAt(a, i)));  // again: the same
+  }
+  EXPECT_EQ(seeds.size(), 3u);
+  EXPECT_NEAR(mean_along, 0.5, 0.15);
+  std::string other = text;
+  other.replace(other.find("\"seed\": 9"), 9, "\"seed\": 8");
+  const SweepSpec b = LoadSweepSpec(Write("r2.json", other));
+  EXPECT_NE(PointAt(a, 0).at[0].along, PointAt(b, 0).at[0].along);
+}
+
+// Each bad spec: InputError naming the spec file and the field.
+TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {"unknown_axis", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "lens", "values": [1]}]})", "axes[0].key"},
+      {"empty_values", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "avatar", "values": []}]})", "axes[0].values"},
+      {"bad_value", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "avatar", "values": ["p1", "nobody"]}]})", "axes[0].values[1]"},
+      {"empty_range", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"camera": "side", "along": {"from": [-3, 0], "to": [-3, 1], "steps": 2},
+                   "height": {"from": 2, "to": 2, "steps": 3}}]})", "axes[0].height"},
+      {"outside", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"camera": "side", "along": {"from": [-3, 0], "to": [-9, 0], "steps": 2}, "height": 2}]})",
+       "axes[0].along"},
+      {"no_camera", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"camera": "back", "along": {"from": [-3, 0], "to": [-3, 1], "steps": 2}, "height": 2}]})",
+       "axes[0].camera"},
+      {"metric", R"({"format": "irbench.sweep/1", "name": "b", "base": {}, "metric": "speed",
+         "axes": [{"key": "seed", "values": [1]}]})", "metric"},
+      {"no_axes", R"({"format": "irbench.sweep/1", "name": "b", "base": {}, "axes": []})", "axes"},
+      {"samples", R"({"format": "irbench.sweep/1", "name": "b", "base": {}, "mode": "random", "samples": 0,
+         "axes": [{"key": "seed", "values": [1]}]})", "samples"},
+      {"base_key", R"({"format": "irbench.sweep/1", "name": "b", "base": {"lens": 2},
+         "axes": [{"key": "seed", "values": [1]}]})", "base.lens"},
+  };
+  for (const auto& [name, text, field] : cases) {
+    const fs::path file = Write(name + ".json", text);
+    try {
+      LoadSweepSpec(file);
+      ADD_FAILURE() << name << ": accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), file.string()) << name << ": " << e.what();
+      EXPECT_EQ(e.field(), field) << name << ": " << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace irbench
