@@ -70,8 +70,10 @@ int SubmitCommand(const CLI::App& cmd, SweepArgs& args) {
     std::cout << "every point is done: nothing to submit; `irbench sweep collect` writes the tables\n";
     return kExitOk;
   }
-  std::cout << s.indices.size() << " point(s) in " << s.script.string() << "\n";
-  if (!s.job_id.empty()) std::cout << "submitted: job " << s.job_id << "\n";
+  std::cout << s.indices.size() << " point(s) in";
+  for (const auto& script : s.scripts) std::cout << " " << script.string();
+  std::cout << "\n";
+  for (const std::string& id : s.job_ids) std::cout << "submitted: job " << id << "\n";
   return kExitOk;
 }
 

@@ -159,17 +159,20 @@ bool HaveSlurm() {
          Shell("test -x /usr/sbin/slurmctld && test -x /usr/sbin/slurmd && command -v sbatch >/dev/null") == 0;
 }
 
-// The same sweep through a real one-node Slurm (a job array of run-one
-// tasks) and here with --jobs 2: the same point files, byte for byte; a lost
-// point is submitted again alone.
+// The same sweep through a real one-node Slurm (job arrays of run-one
+// tasks, one per search generation, chained) and here with --jobs 2: the
+// same point files, byte for byte; a lost point is submitted again alone.
 TEST(SweepTest, SlurmJobArrayGivesTheSameBytesAsRunningHere) {
   if (!HaveSlurm()) GTEST_SKIP() << "no Slurm (apt-get install munge slurmctld slurmd slurm-client)";
   const fs::path dir = FreshTempDir("sweep_slurm");
-  const fs::path spec = dir / "seeds.json";
-  WriteText(spec, R"({"format": "irbench.sweep/1", "name": "seeds3",
+  const fs::path spec = dir / "search.json";
+  // A search: its second generation's array waits for the first's
+  // (--dependency) and draws its placements from the first's metrics.
+  WriteText(spec, R"({"format": "irbench.sweep/1", "name": "search4",
     "base": {"rig": "theater4", "avatar": "p4", "motion": "wave", "sensor": "thesis", "frames": 6,
              "background_frames": 4},
-    "axes": [{"key": "seed", "values": [1, 2, 3]}]})");
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -1.0], "to": [-3.6, 1.0]}, "height": {"from": 1.2, "to": 2.8}}],
+    "mode": "search", "seed": 2, "search": {"population": 2, "generations": 2, "elite": 1}})");
   const fs::path cache = dir / "cache";
   const Result here = RunIrbench({"sweep", "run", spec.string(), "--jobs", "2", "--out", (dir / "here").string(),
                                   "--cache", cache.string()}, dir);
@@ -182,19 +185,21 @@ TEST(SweepTest, SlurmJobArrayGivesTheSameBytesAsRunningHere) {
     args.insert(args.end(), where.begin(), where.end());
     const Result r = RunIrbench(args, dir);
     EXPECT_EQ(r.exit_code, 0) << r.err;
-    const size_t at = r.out.find("submitted: job ");
+    const size_t at = r.out.rfind("submitted: job ");  // the last generation's
     EXPECT_NE(at, std::string::npos) << r.out;
     return at == std::string::npos ? std::string("0") : r.out.substr(at + 15, r.out.find('\n', at) - at - 15);
   };
   const std::string job = submit();
   ASSERT_TRUE(slurm.Wait(job, 300)) << "job " << job << " still queued";
-  for (const char* point : {"p0000.json", "p0001.json", "p0002.json"}) {
+  EXPECT_TRUE(fs::is_regular_file(dir / "there" / "slurm" / "sweep-2.sbatch"));  // generation 1's array
+  for (const char* point : {"p0000.json", "p0001.json", "p0002.json", "p0003.json"}) {
     EXPECT_EQ(ReadText(dir / "there" / "points" / point), ReadText(dir / "here" / "points" / point)) << point;
   }
   // A lost point (a task killed): submit again runs it alone.
   fs::remove(dir / "there" / "points" / "p0001.json");
   const std::string again = submit();
-  EXPECT_NE(ReadText(dir / "there" / "slurm" / "sweep-2.sbatch").find("#SBATCH --array=1\n"), std::string::npos);
+  EXPECT_NE(ReadText(dir / "there" / "slurm" / "sweep-3.sbatch").find("#SBATCH --array=1\n"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "there" / "slurm" / "sweep-4.sbatch"));  // generation 1 is done
   ASSERT_TRUE(slurm.Wait(again, 300));
   EXPECT_EQ(ReadText(dir / "there" / "points" / "p0001.json"), ReadText(dir / "here" / "points" / "p0001.json"));
   std::vector<std::string> collect = {"sweep", "collect", spec.string()};

@@ -33,7 +33,7 @@ std::string ReadAll(const fs::path& file) {
 // Runs one point: its scenario rendered (cached), tracked and scored; its
 // point file written last, atomically.
 void RunPoint(const SweepContext& sweep, int index, std::mutex* render_mutex) {
-  const SweepPoint point = PointAt(sweep.spec, index);
+  const SweepPoint point = PointAt(sweep.spec, index, PointMetrics(sweep));
   const Scenario sc = PointScenario(sweep.spec, point, sweep.out / "rigs");
   fs::path report;
   const Measured m = RunScenario(sc, "sweep " + sweep.spec.name, sweep.cache, render_mutex, &report);
@@ -69,8 +69,9 @@ fs::path FindSbatch(const fs::path& given) {
                      "write the script only)");
 }
 
-// Runs `sbatch --parsable script`; returns the job id it prints.
-std::string RunSbatch(const fs::path& sbatch, const fs::path& script) {
+// Runs `sbatch --parsable [--dependency=afterany:AFTER] script`; returns the
+// job id it prints.
+std::string RunSbatch(const fs::path& sbatch, const fs::path& script, const std::string& after) {
   const fs::path log = script.parent_path() / (script.stem().string() + ".submit.log");
   const pid_t pid = ::fork();
   if (pid < 0) throw RuntimeError("cannot start sbatch: fork failed");
@@ -80,7 +81,12 @@ std::string RunSbatch(const fs::path& sbatch, const fs::path& script) {
       ::dup2(fd, 1);
       ::dup2(fd, 2);
     }
-    ::execl(sbatch.c_str(), "sbatch", "--parsable", script.c_str(), static_cast<char*>(nullptr));
+    const std::string dependency = "--dependency=afterany:" + after;
+    if (after.empty()) {
+      ::execl(sbatch.c_str(), "sbatch", "--parsable", script.c_str(), static_cast<char*>(nullptr));
+    } else {
+      ::execl(sbatch.c_str(), "sbatch", "--parsable", dependency.c_str(), script.c_str(), static_cast<char*>(nullptr));
+    }
     ::_exit(127);
   }
   int status = 0;
@@ -151,6 +157,16 @@ SweepContext OpenSweep(const SweepOptions& options) {
   return sweep;
 }
 
+PointMetric PointMetrics(const SweepContext& sweep) {
+  return [&sweep](int index) -> std::optional<double> {
+    const fs::path file = PointFile(sweep, index);
+    if (!fs::is_regular_file(file)) return std::nullopt;
+    const JsonNode metrics = ParseJsonFile(file.string())["metrics"];
+    if (!metrics.Has(sweep.spec.metric)) return std::nullopt;
+    return metrics[sweep.spec.metric].Number();
+  };
+}
+
 std::vector<int> MissingPoints(const SweepContext& sweep) {
   std::vector<int> out;
   const int n = PointCount(sweep.spec);
@@ -164,7 +180,10 @@ SweepRun RunSweep(const SweepOptions& options, std::optional<int> only) {
   const SweepContext sweep = OpenSweep(options);
   SweepRun run;
   run.total = PointCount(sweep.spec);
-  if (only) PointAt(sweep.spec, *only);  // checks the index
+  if (only && (*only < 0 || *only >= run.total)) {
+    throw InputError(options.spec.string(), "INDEX",
+                     "point " + std::to_string(*only) + " of 0.." + std::to_string(run.total - 1));
+  }
   std::vector<int> todo = MissingPoints(sweep);
   run.done_before = run.total - static_cast<int>(todo.size());
   if (only) {
@@ -182,29 +201,38 @@ SweepRun RunSweep(const SweepOptions& options, std::optional<int> only) {
   Progress progress("sweep " + sweep.spec.name, "points", static_cast<int>(todo.size()));
   progress.IgnoreQuiet();
   std::mutex mutex, render_mutex;
-  std::atomic<size_t> next{0};
-  const auto work = [&] {
-    for (size_t i; (i = next++) < todo.size();) {
-      std::string why;
-      try {
-        RunPoint(sweep, todo[i], &render_mutex);
-      } catch (const std::exception& e) {
-        why = e.what();
-        Log().error("sweep {}: {} failed: {}", sweep.spec.name, PointName(todo[i]), why);
-      }
-      const std::lock_guard<std::mutex> lock(mutex);
-      if (why.empty()) {
-        ++run.ran;
-      } else {
-        run.failed.emplace_back(todo[i], why);
-      }
-      progress.Set(run.ran + static_cast<int>(run.failed.size()), "points done");
+  // A generation at a time: a search's points need the generations before.
+  for (int g = 0, generations = GenerationCount(sweep.spec); g < generations && run.failed.empty(); ++g) {
+    std::vector<int> now;
+    for (const int i : todo) {
+      if (only || GenerationOf(sweep.spec, i) == g) now.push_back(i);
     }
-  };
-  std::vector<std::thread> pool;
-  for (size_t w = 1; w < workers; ++w) pool.emplace_back(work);
-  if (workers > 0) work();
-  for (std::thread& t : pool) t.join();
+    std::atomic<size_t> next{0};
+    const auto work = [&] {
+      for (size_t i; (i = next++) < now.size();) {
+        std::string why;
+        try {
+          RunPoint(sweep, now[i], &render_mutex);
+        } catch (const std::exception& e) {
+          why = e.what();
+          Log().error("sweep {}: {} failed: {}", sweep.spec.name, PointName(now[i]), why);
+        }
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (why.empty()) {
+          ++run.ran;
+        } else {
+          run.failed.emplace_back(now[i], why);
+        }
+        progress.Set(run.ran + static_cast<int>(run.failed.size()), "points done");
+      }
+    };
+    const size_t pool_size = std::min(workers, now.size());
+    std::vector<std::thread> pool;
+    for (size_t w = 1; w < pool_size; ++w) pool.emplace_back(work);
+    if (pool_size > 0) work();
+    for (std::thread& t : pool) t.join();
+    if (only) break;
+  }
   std::sort(run.failed.begin(), run.failed.end());
   return run;
 }
@@ -220,23 +248,39 @@ SlurmSubmission SubmitSweep(const SweepOptions& options, const SlurmOptions& slu
   fs::create_directories(dir);
   int k = 1;
   while (fs::exists(dir / ("sweep-" + std::to_string(k) + ".sbatch"))) ++k;
-  out.script = dir / ("sweep-" + std::to_string(k) + ".sbatch");
-  std::ostringstream s;
-  s << "#!/bin/sh\n"
-    << "# irbench sweep " << sweep.spec.name << ": the " << out.indices.size() << " point(s) not done of "
-    << PointCount(sweep.spec) << "; written by `irbench sweep submit`.\n"
-    << "#SBATCH --job-name=irbench-" << sweep.spec.name << "\n"
-    << "#SBATCH --array=" << ArrayRanges(out.indices)
-    << (slurm.max_parallel > 0 ? "%" + std::to_string(slurm.max_parallel) : std::string()) << "\n"
-    << "#SBATCH --output=" << (dir / ("sweep-" + std::to_string(k) + "-%a.log")).string() << "\n"
-    << "#SBATCH --cpus-per-task=2\n";
-  for (const std::string& line : slurm.sbatch_lines) s << "#SBATCH " << line << "\n";
-  s << "exec " << ShellQuote(irbench.string()) << " sweep run-one " << ShellQuote(fs::absolute(options.spec).string())
-    << " \"$SLURM_ARRAY_TASK_ID\" --out " << ShellQuote(fs::absolute(sweep.out).string()) << " --cache "
-    << ShellQuote(fs::absolute(sweep.cache).string()) << "\n";
-  AtomicWriteFile(out.script, s.str());
-  fs::permissions(out.script, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
-  if (slurm.submit) out.job_id = RunSbatch(sbatch, out.script);
+  std::string after;
+  for (int g = 0, generations = GenerationCount(sweep.spec); g < generations; ++g) {
+    std::vector<int> array;
+    for (const int i : out.indices) {
+      if (GenerationOf(sweep.spec, i) == g) array.push_back(i);
+    }
+    if (array.empty()) continue;
+    const std::string name = "sweep-" + std::to_string(k++);
+    const fs::path script = dir / (name + ".sbatch");
+    std::ostringstream s;
+    s << "#!/bin/sh\n"
+      << "# irbench sweep " << sweep.spec.name << ": " << array.size() << " point(s) not done of "
+      << PointCount(sweep.spec)
+      << (GenerationCount(sweep.spec) > 1 ? " (search generation " + std::to_string(g) + ")" : std::string())
+      << "; written by `irbench sweep submit`.\n"
+      << "#SBATCH --job-name=irbench-" << sweep.spec.name << "\n"
+      << "#SBATCH --array=" << ArrayRanges(array)
+      << (slurm.max_parallel > 0 ? "%" + std::to_string(slurm.max_parallel) : std::string()) << "\n"
+      << "#SBATCH --output=" << (dir / (name + "-%a.log")).string() << "\n"
+      << "#SBATCH --cpus-per-task=2\n";
+    for (const std::string& line : slurm.sbatch_lines) s << "#SBATCH " << line << "\n";
+    s << "exec " << ShellQuote(irbench.string()) << " sweep run-one "
+      << ShellQuote(fs::absolute(options.spec).string()) << " \"$SLURM_ARRAY_TASK_ID\" --out "
+      << ShellQuote(fs::absolute(sweep.out).string()) << " --cache " << ShellQuote(fs::absolute(sweep.cache).string())
+      << "\n";
+    AtomicWriteFile(script, s.str());
+    fs::permissions(script, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+    out.scripts.push_back(script);
+    if (slurm.submit) {
+      after = RunSbatch(sbatch, script, after);
+      out.job_ids.push_back(after);
+    }
+  }
   return out;
 }
 

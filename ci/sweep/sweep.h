@@ -38,6 +38,8 @@ struct SweepContext {
 SweepContext OpenSweep(const SweepOptions& options);
 
 std::filesystem::path PointFile(const SweepContext& sweep, int index);
+// The spec's metric of each finished point, read from its point file.
+PointMetric PointMetrics(const SweepContext& sweep);
 // The indices without a point file yet, ascending.
 std::vector<int> MissingPoints(const SweepContext& sweep);
 
@@ -49,8 +51,10 @@ struct SweepRun {
 };
 
 // Runs the points without a point file, `jobs` at a time (renders one at a
-// time, tracking and scoring side by side); a failing point is logged and the
-// others go on. With `only`, runs that point alone (when not done).
+// time, tracking and scoring side by side), a search's generations one after
+// another; a failing point is logged and the others of its generation go on
+// (a search stops after that generation). With `only`, runs that point alone
+// (when not done).
 SweepRun RunSweep(const SweepOptions& options, std::optional<int> only = std::nullopt);
 
 struct SweepCollected {
@@ -75,14 +79,16 @@ struct SlurmOptions {
 };
 
 struct SlurmSubmission {
-  std::filesystem::path script;
-  std::vector<int> indices;  // the array: the points not done
-  std::string job_id;        // empty when not submitted (nothing missing, or submit = false)
+  std::vector<std::filesystem::path> scripts;  // one per generation with points not done
+  std::vector<int> indices;                     // the points not done
+  std::vector<std::string> job_ids;             // empty when not submitted (nothing missing, or submit = false)
 };
 
 // Writes OUT/slurm/sweep-<k>.sbatch, a job array over the missing points,
 // each task `irbench sweep run-one SPEC $SLURM_ARRAY_TASK_ID --out OUT
-// --cache CACHE` with its log in OUT/slurm/, and submits it with sbatch.
+// --cache CACHE` with its log in OUT/slurm/, and submits it with sbatch. A
+// search gets one array per generation with missing points, each submitted
+// to start after the one before has ended (--dependency=afterany).
 SlurmSubmission SubmitSweep(const SweepOptions& options, const SlurmOptions& slurm);
 
 }  // namespace irbench

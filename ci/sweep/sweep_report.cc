@@ -47,8 +47,30 @@ std::string CoordinateText(const nlohmann::json& v) {
   return v.dump();
 }
 
+// A point's place from its file's coordinates (a search point whose earlier
+// generations are no longer all there cannot be drawn again).
+SweepPoint FromCoordinates(const SweepSpec& spec, int index, const nlohmann::json& c) {
+  SweepPoint point;
+  point.index = index;
+  point.at.resize(spec.axes.size());
+  for (size_t k = 0; k < spec.axes.size(); ++k) {
+    const std::string& name = spec.axes[k].name;
+    AxisValue& at = point.at[k];
+    if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
+      at.along = c.value(name + ".along", 0.0);
+      at.height = c.value(name + ".height", 0.0);
+      const nlohmann::json p = c.value(name + ".position", nlohmann::json::array({0, 0, 0}));
+      at.position = {p[0].get<double>(), p[1].get<double>(), p[2].get<double>()};
+    } else {
+      at.value = c.value(name, nlohmann::json());
+    }
+  }
+  return point;
+}
+
 std::vector<Done> ReadPoints(const SweepContext& sweep, std::vector<int>* missing) {
   std::vector<Done> out;
+  const PointMetric metric_of = PointMetrics(sweep);
   for (int i = 0, n = PointCount(sweep.spec); i < n; ++i) {
     const fs::path file = PointFile(sweep, i);
     if (!fs::is_regular_file(file)) {
@@ -61,8 +83,12 @@ std::vector<Done> ReadPoints(const SweepContext& sweep, std::vector<int>* missin
     if (root.GetInt("index") != i) root["index"].Fail("expected " + std::to_string(i));
     Done d;
     d.index = i;
-    d.point = PointAt(sweep.spec, i);
     d.coordinates = root["coordinates"].raw();
+    try {
+      d.point = PointAt(sweep.spec, i, metric_of);
+    } catch (const RuntimeError&) {
+      d.point = FromCoordinates(sweep.spec, i, d.coordinates);
+    }
     const JsonNode metrics = root["metrics"];
     for (const std::string& key : metrics.Keys()) d.metrics[key] = metrics[key].Number();
     d.report = root.GetString("report", "");
@@ -177,7 +203,7 @@ std::string AxisTables(const SweepSpec& spec, const std::vector<Done>& points) {
       ++by[key].second;
     };
     const bool placed = std::holds_alternative<PlacementAxis>(axis.axis);
-    if (placed && spec.mode == "random") continue;  // continuous: the heat map shows it
+    if (placed && spec.mode != "grid") continue;  // continuous: the heat map shows it
     for (const Done& d : points) {
       const AxisValue& at = d.point.at[k];
       add(placed ? "height " + Short(at.height) + " m, along " + Short(at.along) : CoordinateText(at.value), d);
@@ -253,6 +279,32 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
   return svg.str();
 }
 
+// Markdown: a search's convergence, generation by generation.
+std::string Convergence(const SweepSpec& spec, const std::vector<Done>& points) {
+  const bool higher = HigherIsBetter(spec.metric);
+  std::ostringstream out;
+  out << "| generation | evaluations | generation's best | generation's mean | best so far |\n|---|---|---|---|---|\n";
+  double best = higher ? -1e300 : 1e300;
+  int evaluations = 0;
+  for (int g = 0; g < GenerationCount(spec); ++g) {
+    double gen_best = higher ? -1e300 : 1e300, sum = 0;
+    int n = 0;
+    for (const Done& d : points) {
+      const auto it = d.metrics.find(spec.metric);
+      if (GenerationOf(spec, d.index) != g || it == d.metrics.end()) continue;
+      gen_best = higher ? std::max(gen_best, it->second) : std::min(gen_best, it->second);
+      sum += it->second;
+      ++n;
+    }
+    if (n == 0) break;
+    evaluations += n;
+    best = higher ? std::max(best, gen_best) : std::min(best, gen_best);
+    out << "| " << g << " | " << evaluations << " | " << Short(gen_best) << " | " << Short(sum / n) << " | "
+        << Short(best) << " |\n";
+  }
+  return out.str();
+}
+
 // How to render, track and score the best point alone.
 std::string ReproduceText(const SweepContext& sweep, const Done& best) {
   const Scenario sc = PointScenario(sweep.spec, best.point, sweep.out / "rigs");
@@ -295,6 +347,8 @@ SweepCollected CollectSweep(const SweepOptions& options) {
     md << "\n" << best_text;
   }
   const std::string rank_table = RankTable(spec, ranked), axis_tables = AxisTables(spec, points);
+  const std::string convergence = spec.mode == "search" ? Convergence(spec, points) : std::string();
+  if (!convergence.empty()) md << "\n## Search convergence\n\n" << convergence;
   md << "\n## Points, best first\n\n" << rank_table << "\n## " << spec.metric << " by axis\n" << axis_tables;
   out.md = sweep.out / "sweep.md";
   AtomicWriteFile(out.md, md.str());
@@ -312,6 +366,7 @@ SweepCollected CollectSweep(const SweepOptions& options) {
     if (!std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) continue;
     html << "<h2>Placement of " << HtmlEscape(spec.axes[k].name) << "</h2>\n" << HeatMap(spec, k, points);
   }
+  if (!convergence.empty()) html << "<h2>Search convergence</h2>\n" << MarkdownTableHtml(convergence);
   html << "<h2>Points, best first</h2>\n" << MarkdownTableHtml(rank_table) << "<h2>" << HtmlEscape(spec.metric)
        << " by axis</h2>\n" << MarkdownTableHtml(axis_tables) << "<h2>Each point's report, worst first</h2>\n<ul>\n";
   for (auto it = ranked.rbegin(); it != ranked.rend(); ++it) {

@@ -1,7 +1,7 @@
 #include "ci/sweep/sweep_spec.h"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <set>
@@ -34,8 +34,10 @@ int CheckSteps(const JsonNode& node) {
   return steps;
 }
 
-// `{"from": a, "to": b, "steps": n}` or one number (one step).
-SweepRange ReadRange(const JsonNode& node) {
+// `{"from": a, "to": b, "steps": n}` or one number (one step). A grid needs
+// `steps` where from and to differ; random and search points fall anywhere
+// between them.
+SweepRange ReadRange(const JsonNode& node, bool grid) {
   SweepRange range;
   if (node.raw().is_number()) {
     range.from = range.to = node.Number();
@@ -44,13 +46,14 @@ SweepRange ReadRange(const JsonNode& node) {
   node.CheckKeys({"from", "to", "steps"});
   range.from = node.GetDouble("from");
   range.to = node.GetDouble("to");
-  range.steps = CheckSteps(node["steps"]);
+  range.steps = node.Has("steps") ? CheckSteps(node["steps"]) : 1;
   if (!std::isfinite(range.from) || !std::isfinite(range.to)) node.Fail("from and to must be finite");
+  if (grid && range.steps == 1 && range.from != range.to) node.Fail("from and to differ: give steps (a grid)");
   if (range.steps > 1 && range.from == range.to) node.Fail("an empty range: from equals to with several steps");
   return range;
 }
 
-PlacementAxis ReadPlacement(const JsonNode& a) {
+PlacementAxis ReadPlacement(const JsonNode& a, bool grid) {
   a.CheckKeys({"camera", "along", "height", "look_at", "up"});
   PlacementAxis p;
   p.camera = a.GetString("camera");
@@ -60,7 +63,8 @@ PlacementAxis ReadPlacement(const JsonNode& a) {
   p.to = along["to"].Vec2();
   p.steps = along.Has("steps") ? CheckSteps(along["steps"]) : 1;
   if (p.steps > 1 && (p.from - p.to).norm() < 1e-9) along.Fail("an empty range: from equals to with several steps");
-  p.height = ReadRange(a["height"]);
+  if (grid && p.steps == 1 && (p.from - p.to).norm() >= 1e-9) along.Fail("from and to differ: give steps (a grid)");
+  p.height = ReadRange(a["height"], grid);
   if (a.Has("look_at")) p.look_at = a["look_at"].Vec3();
   if (a.Has("up")) {
     p.has_up = true;
@@ -157,6 +161,72 @@ double Uniform(uint64_t seed, int index, size_t axis, int which) {
   return double(h >> 11) * (1.0 / 9007199254740992.0);
 }
 
+void ReadSearch(const JsonNode& search, SweepSpec* spec) {
+  search.CheckKeys({"method", "population", "generations", "elite"});
+  if (search.GetString("method", "cross_entropy") != "cross_entropy") search["method"].Fail("expected \"cross_entropy\"");
+  spec->population = search.GetInt("population");
+  if (spec->population < 2 || spec->population > 10000) search["population"].Fail("must be in 2..10000");
+  spec->generations = search.GetInt("generations");
+  if (spec->generations < 1 || spec->generations > 1000) search["generations"].Fail("must be in 1..1000");
+  spec->elite = search.GetInt("elite", std::max(1, spec->population / 4));
+  if (spec->elite < 1 || spec->elite > spec->population) search["elite"].Fail("must be in 1..population");
+}
+
+// A standard normal number from (seed, index, dim) (Box-Muller).
+double Normal(uint64_t seed, int index, size_t dim) {
+  const double u1 = std::max(Uniform(seed, index, dim, 2), 1e-300), u2 = Uniform(seed, index, dim, 3);
+  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
+}
+
+// The cross-entropy method's sampling distribution, per unit coordinate
+// (each placement: along 0..1, height 0..1 from `from` to `to`).
+struct Gaussian {
+  std::vector<double> mean, sigma;
+  // Point `index`'s unit coordinates: the mean itself, or drawn and clipped.
+  std::vector<double> Draw(uint64_t seed, int index, bool at_mean) const {
+    std::vector<double> x = mean;
+    if (at_mean) return x;
+    for (size_t d = 0; d < x.size(); ++d) x[d] = std::clamp(mean[d] + sigma[d] * Normal(seed, index, d), 0.0, 1.0);
+    return x;
+  }
+};
+
+// Point `index`'s unit coordinates in a search: the generations before it
+// replayed, each drawn from the distribution that the elite of all points
+// before it gives: their mean, their spread but shrinking to no less than
+// 0.6 of the previous generation's (the elite of a small population would
+// otherwise collapse it before the mean arrives), at least 0.02.
+std::vector<double> SearchUnit(const SweepSpec& spec, int index, const PointMetric& metric_of) {
+  const size_t dims = 2 * spec.axes.size();
+  const int generation = index / spec.population;
+  const double sign = HigherIsBetter(spec.metric) ? -1 : 1;  // smaller is better below
+  Gaussian dist{std::vector<double>(dims, 0.5), std::vector<double>(dims, 0.4)};
+  std::vector<std::pair<double, std::vector<double>>> done;  // (signed metric, unit coordinates)
+  for (int g = 0; g <= generation; ++g) {
+    if (g > 0) {
+      std::stable_sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      const size_t n = std::min<size_t>(spec.elite, done.size());
+      for (size_t d = 0; d < dims; ++d) {
+        double mean = 0, var = 0;
+        for (size_t e = 0; e < n; ++e) mean += done[e].second[d] / n;
+        for (size_t e = 0; e < n; ++e) var += (done[e].second[d] - mean) * (done[e].second[d] - mean) / n;
+        dist.mean[d] = mean;
+        dist.sigma[d] = std::max({std::sqrt(var), 0.6 * dist.sigma[d], 0.02});
+      }
+    }
+    if (g == generation) return dist.Draw(spec.seed, index, g > 0 && index % spec.population == 0);
+    for (int i = g * spec.population; i < (g + 1) * spec.population; ++i) {
+      const std::optional<double> m = metric_of ? metric_of(i) : std::nullopt;
+      if (!m) {
+        throw RuntimeError("sweep " + spec.name + ": " + PointName(index) + " (generation " +
+                           std::to_string(generation) + ") needs " + PointName(i) + " done first");
+      }
+      done.emplace_back(sign * *m, dist.Draw(spec.seed, i, g > 0 && i % spec.population == 0));
+    }
+  }
+  return {};
+}
+
 size_t AxisSize(const SweepAxis& axis) {
   if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) return size_t(p->steps) * p->height.steps;
   return std::get<ValueAxis>(axis.axis).values.size();
@@ -172,7 +242,7 @@ std::string PointName(int index) {
 
 SweepSpec LoadSweepSpec(const fs::path& file) {
   const JsonNode root = ParseJsonFile(file.string());
-  root.CheckKeys({"format", "name", "description", "base", "axes", "mode", "samples", "seed", "metric"});
+  root.CheckKeys({"format", "name", "description", "base", "axes", "mode", "samples", "seed", "search", "metric"});
   if (root.GetString("format") != "irbench.sweep/1") root["format"].Fail("expected \"irbench.sweep/1\"");
   SweepSpec spec;
   spec.file = file;
@@ -186,13 +256,20 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   const Scenario base_scenario = ScenarioOf(spec.base, file);  // checks the base's keys
   spec.inputs = ScenarioInputFiles(base_scenario.render);       // and its files
   spec.mode = root.GetString("mode", "grid");
-  if (spec.mode != "grid" && spec.mode != "random") root["mode"].Fail("expected \"grid\" or \"random\"");
+  if (spec.mode != "grid" && spec.mode != "random" && spec.mode != "search") {
+    root["mode"].Fail("expected \"grid\", \"random\" or \"search\"");
+  }
+  spec.seed = static_cast<uint64_t>(root.GetInt("seed", 1));
   if (spec.mode == "random") {
     spec.samples = root.GetInt("samples");
     if (spec.samples < 1 || spec.samples > kMaxPoints) root["samples"].Fail("must be in 1..1000000");
-    spec.seed = static_cast<uint64_t>(root.GetInt("seed", 1));
   } else if (root.Has("samples")) {
     root["samples"].Fail("only for mode \"random\"");
+  }
+  if (spec.mode == "search") {
+    ReadSearch(root["search"], &spec);
+  } else if (root.Has("search")) {
+    root["search"].Fail("only for mode \"search\"");
   }
   spec.metric = root.GetString("metric", "arms_mean_cm");
   const auto& metrics = KnownMetrics();
@@ -207,6 +284,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
     if (a.Has("camera")) continue;
+    if (spec.mode == "search") a.Fail("mode \"search\" moves cameras only: give other values in the base");
     a.CheckKeys({"key", "values"});
     ValueAxis v;
     v.key = a.GetString("key");
@@ -235,7 +313,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
     if (!a.Has("camera")) continue;
-    PlacementAxis p = ReadPlacement(a);
+    PlacementAxis p = ReadPlacement(a, spec.mode == "grid");
     if (!names.insert(p.camera).second) a["camera"].Fail("camera '" + p.camera + "' is placed twice");
     for (const nlohmann::json& rig : rigs) CheckPlacement(a, p, PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), file)));
     placements.push_back({p.camera, p});
@@ -246,6 +324,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   if (spec.mode == "grid") {
     for (const SweepAxis& axis : spec.axes) count *= double(AxisSize(axis));
   }
+  if (spec.mode == "search") count = double(spec.population) * spec.generations;
   if (count > kMaxPoints) axes.Fail("a grid of " + std::to_string(count) + " points (at most 1000000)");
   spec.canonical = root.raw().dump(2) + "\n";
   return spec;
@@ -253,12 +332,19 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
 
 int PointCount(const SweepSpec& spec) {
   if (spec.mode == "random") return spec.samples;
+  if (spec.mode == "search") return spec.population * spec.generations;
   size_t count = 1;
   for (const SweepAxis& axis : spec.axes) count *= AxisSize(axis);
   return static_cast<int>(count);
 }
 
-SweepPoint PointAt(const SweepSpec& spec, int index) {
+int GenerationOf(const SweepSpec& spec, int index) {
+  return spec.mode == "search" ? index / spec.population : 0;
+}
+
+int GenerationCount(const SweepSpec& spec) { return spec.mode == "search" ? spec.generations : 1; }
+
+SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_of) {
   if (index < 0 || index >= PointCount(spec)) {
     throw InputError(spec.file.string(), "INDEX",
                      "point " + std::to_string(index) + " of 0.." + std::to_string(PointCount(spec) - 1));
@@ -266,6 +352,17 @@ SweepPoint PointAt(const SweepSpec& spec, int index) {
   SweepPoint point;
   point.index = index;
   point.at.resize(spec.axes.size());
+  if (spec.mode == "search") {
+    const std::vector<double> unit = SearchUnit(spec, index, metric_of);
+    for (size_t k = 0; k < spec.axes.size(); ++k) {
+      const auto& p = std::get<PlacementAxis>(spec.axes[k].axis);
+      AxisValue& at = point.at[k];
+      at.along = unit[2 * k];
+      at.height = p.height.from + (p.height.to - p.height.from) * unit[2 * k + 1];
+      at.position = PlacementPosition(p, at.along, at.height);
+    }
+    return point;
+  }
   size_t rest = static_cast<size_t>(index);
   for (size_t k = spec.axes.size(); k-- > 0;) {
     const SweepAxis& axis = spec.axes[k];

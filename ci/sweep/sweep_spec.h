@@ -3,13 +3,18 @@
 // suite's terms, axes — camera placements along a wall or ceiling line and
 // over heights, or lists of values for a scenario key (rig, avatar, motion,
 // sensor, seed, frames, track.<setting>) — and a mode: `grid` (every
-// combination) or seeded `random` samples. Points are numbered; a point's
-// coordinates depend only on the spec and its index, so any process (a local
-// worker, a Slurm array task) can run point i alone.
+// combination), seeded `random` samples, or `search`: the cross-entropy
+// method over the placements, generation by generation, each generation
+// drawn around the best points of the ones before. Points are numbered; a
+// point's coordinates depend only on the spec, its index and (search) the
+// metrics of the earlier generations' points, so any process (a local worker,
+// a Slurm array task) can run point i alone.
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -53,9 +58,14 @@ struct SweepSpec {
   std::filesystem::path file;
   nlohmann::json base;  // the base scenario's keys as written
   std::vector<SweepAxis> axes;
-  std::string mode = "grid";  // grid | random
+  std::string mode = "grid";  // grid | random | search
   int samples = 0;            // random: points
-  uint64_t seed = 1;          // random: the sampler's seed
+  uint64_t seed = 1;          // random, search: the sampler's seed
+  // search (the cross-entropy method): `population` points per generation,
+  // `generations` of them; each generation draws around the mean and spread
+  // of the `elite` best points of all generations before it (its first point
+  // is that mean itself).
+  int population = 0, generations = 0, elite = 0;
   std::string metric = "arms_mean_cm";  // ranks the points (KnownMetrics())
   std::vector<std::filesystem::path> inputs;  // the data files the points read (rigs, avatars, motions ...)
   std::string canonical;  // the spec as parsed, one JSON text: what OUT/spec.json holds
@@ -80,12 +90,24 @@ struct SweepPoint {
 // (a camera outside the scene's bounds, an unknown camera, an empty range).
 SweepSpec LoadSweepSpec(const std::filesystem::path& file);
 
-// grid: the product of the axes' sizes; random: `samples`.
+// grid: the product of the axes' sizes; random: `samples`; search:
+// population x generations.
 int PointCount(const SweepSpec& spec);
 
+// A point's generation (search: index / population; otherwise 0) and how
+// many generations there are: a generation's points need the ones before done.
+int GenerationOf(const SweepSpec& spec, int index);
+int GenerationCount(const SweepSpec& spec);
+
+// The spec's metric of a finished point; nullopt when it is not done (or
+// measured nothing).
+using PointMetric = std::function<std::optional<double>(int index)>;
+
 // Point `index` (0 <= index < PointCount): grid in row-major order over the
-// axes (the last axis fastest); random from a hash of (seed, index, axis).
-SweepPoint PointAt(const SweepSpec& spec, int index);
+// axes (the last axis fastest); random from a hash of (seed, index, axis);
+// search from the seed and the earlier generations' metrics (`metric_of`;
+// RuntimeError naming the point when one of them is not done).
+SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_of = {});
 
 // {"<camera>.along": .., "<camera>.height": .., "<camera>.position": [x,y,z],
 // "<key>": value, ...}

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <tuple>
 
@@ -109,6 +110,44 @@ TEST(SweepSpecTest, RandomPointsAreInRangeAndDependOnlyOnSeedAndIndex) {
   EXPECT_NE(PointAt(a, 0).at[0].along, PointAt(b, 0).at[0].along);
 }
 
+// The cross-entropy search on a known bowl (the metric: the camera's distance
+// from a target on its wall): it needs each generation's predecessors, and
+// its generations close in on the target.
+TEST(SweepSpecTest, SearchClosesInOnTheBestPlacement) {
+  const SweepSpec spec = LoadSweepSpec(Write("search.json", R"({"format": "irbench.sweep/1", "name": "s",
+    "base": {"rig": "theater4", "motion": "wave", "frames": 3}, "mode": "search", "seed": 3,
+    "search": {"population": 6, "generations": 6, "elite": 2},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -2.0], "to": [-3.6, 2.0]},
+              "height": {"from": 1.0, "to": 3.0}}]})"));
+  ASSERT_EQ(PointCount(spec), 36);
+  EXPECT_EQ(GenerationOf(spec, 5), 0);
+  EXPECT_EQ(GenerationOf(spec, 6), 1);
+  EXPECT_THROW(PointAt(spec, 6), RuntimeError);  // generation 1 needs generation 0's metrics
+  const Eigen::Vector3d target(-3.6, 1.1, 2.4);
+  std::map<int, double> memo;
+  PointMetric metric_of;
+  metric_of = [&](int i) -> std::optional<double> {
+    if (!memo.count(i)) memo[i] = (PointAt(spec, i, metric_of).at[0].position - target).norm();
+    return memo[i];
+  };
+  double first = 1e9, last = 1e9;
+  for (int i = 0; i < 6; ++i) first = std::min(first, *metric_of(i));
+  for (int i = 30; i < 36; ++i) last = std::min(last, *metric_of(i));
+  EXPECT_LT(last, first);
+  EXPECT_LT(last, 0.15);
+  // The last generation's first point is its distribution's mean: near the target.
+  EXPECT_LT(*metric_of(30), 0.3);
+  // Every point inside the ranges.
+  for (int i = 0; i < 36; ++i) {
+    const SweepPoint point = PointAt(spec, i, metric_of);
+    const AxisValue& at = point.at[0];
+    EXPECT_GE(at.along, 0.0);
+    EXPECT_LE(at.along, 1.0);
+    EXPECT_GE(at.height, 1.0);
+    EXPECT_LE(at.height, 3.0);
+  }
+}
+
 // Each bad spec: InputError naming the spec file and the field.
 TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
   const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
@@ -132,6 +171,8 @@ TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
       {"no_axes", R"({"format": "irbench.sweep/1", "name": "b", "base": {}, "axes": []})", "axes"},
       {"samples", R"({"format": "irbench.sweep/1", "name": "b", "base": {}, "mode": "random", "samples": 0,
          "axes": [{"key": "seed", "values": [1]}]})", "samples"},
+      {"search_values", R"({"format": "irbench.sweep/1", "name": "b", "base": {}, "mode": "search",
+         "search": {"population": 4, "generations": 2}, "axes": [{"key": "seed", "values": [1]}]})", "axes[0]"},
       {"base_key", R"({"format": "irbench.sweep/1", "name": "b", "base": {"lens": 2},
          "axes": [{"key": "seed", "values": [1]}]})", "base.lens"},
   };
