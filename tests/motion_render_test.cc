@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -134,6 +136,63 @@ TEST(MotionRenderTest, SessionTruthCarriesLabelsPointingAndEvents) {
   // The BVH export of the rendered motion has one frame per rendered frame.
   const std::string bvh = ReadText(seq / "truth/motion.bvh");
   EXPECT_NE(bvh.find("Frames: " + std::to_string(frames) + "\n"), std::string::npos);
+}
+
+// The occlusion library's poses (thesis Fig. 6.10) do what they say, judged
+// by the truth: the hand behind the back is hidden from both frontal cameras
+// (and seen by them at rest); the arm across the chest lies over the torso in
+// the frontal images (its wrist between the shoulders); crossed forearms put
+// each wrist on the other side; hands together meet.
+TEST(MotionRenderTest, OcclusionPosesHideWhatTheySay) {
+  const fs::path dir = FreshTempDir("motion_occlusion");
+  // theater4's two frontal cameras only (the poses are about them).
+  nlohmann::json rig = nlohmann::json::parse(ReadText(fs::path(IRBENCH_SOURCE_DIR) / "rigs" / "theater4.json"));
+  nlohmann::json frontal = nlohmann::json::array();
+  for (const auto& cam : rig["cameras"]) {
+    if (cam["name"] == "front_left" || cam["name"] == "front_right") frontal.push_back(cam);
+  }
+  rig["cameras"] = frontal;
+  WriteText(dir / "frontal.json", rig.dump());
+  std::map<std::string, nlohmann::json> at_rest, held;
+  for (const char* pose : {"arm_behind", "arm_across", "arms_crossed", "hands_together"}) {
+    const fs::path session = dir / (std::string(pose) + ".json");
+    WriteText(session, nlohmann::json{{"format", "irbench.session/1"},
+                                      {"items", {{{"motion", "occlusion"}, {"pose", pose}, {"side", "right"}}}}}
+                           .dump());
+    RenderJobOptions options;
+    options.rig = (dir / "frontal.json").string();
+    options.motion = session.string();
+    options.frames = 40;  // the pose is held from 1.0 s / tempo (at most 1.18 s) for 2 s / tempo
+    options.background_frames = 0;
+    options.supersample = 1;
+    options.out = dir / pose;
+    const fs::path seq = RunRenderJob(options);
+    std::ifstream truth(seq / "truth/frames.jsonl");
+    std::string line;
+    for (int n = 0; std::getline(truth, line); ++n) {
+      if (n == 0) at_rest[pose] = nlohmann::json::parse(line);
+      if (n == 39) held[pose] = nlohmann::json::parse(line);
+    }
+  }
+  const auto vis = [](const nlohmann::json& f, const char* cam, const char* joint) {
+    return f["joints2d"][cam][joint][2].get<int>();
+  };
+  for (const char* cam : {"front_left", "front_right"}) {
+    EXPECT_EQ(vis(at_rest["arm_behind"], cam, "right_wrist"), 2) << cam;
+    EXPECT_EQ(vis(held["arm_behind"], cam, "right_wrist"), 1) << cam;
+    const nlohmann::json& j = held["arm_across"]["joints2d"][cam];
+    const double u = j["right_wrist"][0], a = j["left_shoulder"][0], b = j["right_shoulder"][0];
+    const double lo = std::min(a, b), hi = std::max(a, b);
+    EXPECT_GT(u, lo) << cam;
+    EXPECT_LT(u, hi) << cam;
+  }
+  const auto world = [](const nlohmann::json& f, const char* joint) {
+    return Eigen::Vector3d(f["joints3d"][joint][0], f["joints3d"][joint][1], f["joints3d"][joint][2]);
+  };
+  // The person faces +y, their right is +x: crossed, the right wrist is left of the left wrist.
+  EXPECT_LT(world(held["arms_crossed"], "right_wrist").x(), world(held["arms_crossed"], "left_wrist").x());
+  EXPECT_GT(world(at_rest["arms_crossed"], "right_wrist").x(), world(at_rest["arms_crossed"], "left_wrist").x());
+  EXPECT_LT((world(held["hands_together"], "right_wrist") - world(held["hands_together"], "left_wrist")).norm(), 0.15);
 }
 
 }  // namespace

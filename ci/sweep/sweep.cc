@@ -34,7 +34,7 @@ std::string ReadAll(const fs::path& file) {
 // point file written last, atomically.
 void RunPoint(const SweepContext& sweep, int index, std::mutex* render_mutex) {
   const SweepPoint point = PointAt(sweep.spec, index, PointMetrics(sweep));
-  const Scenario sc = PointScenario(sweep.spec, point, sweep.out / "rigs");
+  const Scenario sc = PointScenario(sweep.spec, point, sweep.out);
   fs::path report;
   const Measured m = RunScenario(sc, "sweep " + sweep.spec.name, sweep.cache, render_mutex, &report);
   nlohmann::json metrics = nlohmann::json::object();

@@ -47,6 +47,27 @@ std::string CoordinateText(const nlohmann::json& v) {
   return v.dump();
 }
 
+// A pose's ranged components' names: "right_shoulder.z".
+std::vector<std::string> PoseNames(const PoseAxis& pose) {
+  std::vector<std::string> out;
+  for (const PoseDim& d : pose.dims) out.push_back(d.joint + "." + "xyz"[d.component]);
+  return out;
+}
+
+// A point's place on one axis, short.
+std::string AxisText(const SweepAxis& axis, const AxisValue& at) {
+  if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
+    std::string out;
+    const std::vector<std::string> names = PoseNames(*pose);
+    for (size_t d = 0; d < names.size(); ++d) out += (d ? ", " : "") + names[d] + " " + Short(at.pose[d]);
+    return out;
+  }
+  if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+    return CoordinateText(nlohmann::json{at.position.x(), at.position.y(), at.position.z()});
+  }
+  return CoordinateText(at.value);
+}
+
 // A point's place from its file's coordinates (a search point whose earlier
 // generations are no longer all there cannot be drawn again).
 SweepPoint FromCoordinates(const SweepSpec& spec, int index, const nlohmann::json& c) {
@@ -56,7 +77,9 @@ SweepPoint FromCoordinates(const SweepSpec& spec, int index, const nlohmann::jso
   for (size_t k = 0; k < spec.axes.size(); ++k) {
     const std::string& name = spec.axes[k].name;
     AxisValue& at = point.at[k];
-    if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
+    if (const auto* pose = std::get_if<PoseAxis>(&spec.axes[k].axis)) {
+      for (const std::string& dim : PoseNames(*pose)) at.pose.push_back(c.value(name + "." + dim, 0.0));
+    } else if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
       at.along = c.value(name + ".along", 0.0);
       at.height = c.value(name + ".height", 0.0);
       const nlohmann::json p = c.value(name + ".position", nlohmann::json::array({0, 0, 0}));
@@ -97,9 +120,10 @@ std::vector<Done> ReadPoints(const SweepContext& sweep, std::vector<int>* missin
   return out;
 }
 
-// Best first by the spec's metric; points without it last, by index.
+// Best first by the spec's metric (adversarial: the worst first); points
+// without it last, by index.
 void Rank(const SweepSpec& spec, std::vector<Done>* points) {
-  const bool higher = HigherIsBetter(spec.metric);
+  const bool higher = SeeksHigh(spec);
   std::stable_sort(points->begin(), points->end(), [&](const Done& a, const Done& b) {
     const auto ia = a.metrics.find(spec.metric), ib = b.metrics.find(spec.metric);
     if (ia == a.metrics.end() || ib == b.metrics.end()) return ia != a.metrics.end() && ib == b.metrics.end();
@@ -124,7 +148,9 @@ std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const st
   std::ostringstream out;
   out << "point";
   for (const SweepAxis& axis : spec.axes) {
-    if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+    if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
+      for (const std::string& dim : PoseNames(*pose)) out << "," << axis.name << "." << dim;
+    } else if (std::holds_alternative<PlacementAxis>(axis.axis)) {
       for (const char* c : {".along", ".height", ".x", ".y", ".z"}) out << "," << axis.name << c;
     } else {
       out << "," << axis.name;
@@ -136,7 +162,9 @@ std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const st
     out << d.index;
     for (size_t k = 0; k < spec.axes.size(); ++k) {
       const AxisValue& at = d.point.at[k];
-      if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
+      if (std::holds_alternative<PoseAxis>(spec.axes[k].axis)) {
+        for (const double v : at.pose) out << "," << Num(v);
+      } else if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
         out << "," << Num(at.along) << "," << Num(at.height) << "," << Num(at.position.x()) << ","
             << Num(at.position.y()) << "," << Num(at.position.z());
       } else {
@@ -175,13 +203,7 @@ std::string RankTable(const SweepSpec& spec, const std::vector<Done>& ranked) {
   for (size_t r = 0; r < ranked.size(); ++r) {
     const Done& d = ranked[r];
     out << "| " << r + 1 << " | " << PointName(d.index) << " |";
-    for (size_t k = 0; k < spec.axes.size(); ++k) {
-      const AxisValue& at = d.point.at[k];
-      const bool placed = std::holds_alternative<PlacementAxis>(spec.axes[k].axis);
-      out << " " << (placed ? CoordinateText(nlohmann::json{at.position.x(), at.position.y(), at.position.z()})
-                            : CoordinateText(at.value))
-          << " |";
-    }
+    for (size_t k = 0; k < spec.axes.size(); ++k) out << " " << AxisText(spec.axes[k], d.point.at[k]) << " |";
     for (const std::string& m : shown) out << " " << Value(d, m) << " |";
     out << "\n";
   }
@@ -203,10 +225,10 @@ std::string AxisTables(const SweepSpec& spec, const std::vector<Done>& points) {
       ++by[key].second;
     };
     const bool placed = std::holds_alternative<PlacementAxis>(axis.axis);
-    if (placed && spec.mode != "grid") continue;  // continuous: the heat map shows it
+    if (!std::holds_alternative<ValueAxis>(axis.axis) && spec.mode != "grid") continue;  // continuous
     for (const Done& d : points) {
       const AxisValue& at = d.point.at[k];
-      add(placed ? "height " + Short(at.height) + " m, along " + Short(at.along) : CoordinateText(at.value), d);
+      add(placed ? "height " + Short(at.height) + " m, along " + Short(at.along) : AxisText(axis, at), d);
     }
     out << "\n### " << axis.name << "\n\n| " << (placed ? "placement" : axis.name) << " | points | mean "
         << spec.metric << " |\n|---|---|---|\n";
@@ -281,7 +303,7 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
 
 // Markdown: a search's convergence, generation by generation.
 std::string Convergence(const SweepSpec& spec, const std::vector<Done>& points) {
-  const bool higher = HigherIsBetter(spec.metric);
+  const bool higher = SeeksHigh(spec);
   std::ostringstream out;
   out << "| generation | evaluations | generation's best | generation's mean | best so far |\n|---|---|---|---|---|\n";
   double best = higher ? -1e300 : 1e300;
@@ -307,7 +329,7 @@ std::string Convergence(const SweepSpec& spec, const std::vector<Done>& points) 
 
 // How to render, track and score the best point alone.
 std::string ReproduceText(const SweepContext& sweep, const Done& best) {
-  const Scenario sc = PointScenario(sweep.spec, best.point, sweep.out / "rigs");
+  const Scenario sc = PointScenario(sweep.spec, best.point, sweep.out);
   const RenderJobOptions& r = sc.render;
   std::ostringstream out;
   out << "irbench render --rig " << r.rig << (r.scene.empty() ? "" : " --scene " + r.scene) << " --avatar "
@@ -334,7 +356,8 @@ SweepCollected CollectSweep(const SweepOptions& options) {
   std::ostringstream md;
   md << "# sweep " << spec.name << "\n\n" << spec.description << "\n\n" << out.done << " of " << out.total
      << " points done (mode " << spec.mode << "), ranked by " << spec.metric << " ("
-     << (HigherIsBetter(spec.metric) ? "higher" : "lower") << " is better).\n";
+     << (HigherIsBetter(spec.metric) ? "higher" : "lower") << " is better"
+     << (spec.mode == "adversarial" ? "; adversarial: the worst first" : "") << ").\n";
   if (!out.missing.empty()) {
     md << "Not done: " << out.missing.size() << " point(s); `irbench sweep run` or `submit` again runs only them.\n";
   }
@@ -342,12 +365,12 @@ SweepCollected CollectSweep(const SweepOptions& options) {
   if (!ranked.empty() && ranked.front().metrics.count(spec.metric)) {
     const Done& best = ranked.front();
     out.best = best.index;
-    best_text = "## Best: " + PointName(best.index) + ", " + spec.metric + " " + Short(best.metrics.at(spec.metric)) +
+    best_text = std::string(spec.mode == "adversarial" ? "## Hardest: " : "## Best: ") + PointName(best.index) + ", " + spec.metric + " " + Short(best.metrics.at(spec.metric)) +
                 "\n\nAt " + best.coordinates.dump() + ".\n\nAlone: `" + ReproduceText(sweep, best) + "`\n";
     md << "\n" << best_text;
   }
   const std::string rank_table = RankTable(spec, ranked), axis_tables = AxisTables(spec, points);
-  const std::string convergence = spec.mode == "search" ? Convergence(spec, points) : std::string();
+  const std::string convergence = spec.population > 0 ? Convergence(spec, points) : std::string();
   if (!convergence.empty()) md << "\n## Search convergence\n\n" << convergence;
   md << "\n## Points, best first\n\n" << rank_table << "\n## " << spec.metric << " by axis\n" << axis_tables;
   out.md = sweep.out / "sweep.md";
@@ -359,7 +382,7 @@ SweepCollected CollectSweep(const SweepOptions& options) {
        << "<h1>sweep " << HtmlEscape(spec.name) << "</h1>\n<p>" << HtmlEscape(spec.description) << "</p>\n<p>"
        << out.done << " of " << out.total << " points done; ranked by " << HtmlEscape(spec.metric) << ".</p>\n";
   if (out.best) {
-    html << "<h2>Best: " << PointName(*out.best) << "</h2>\n<p><code>" << HtmlEscape(ReproduceText(sweep, ranked.front()))
+    html << "<h2>" << (spec.mode == "adversarial" ? "Hardest: " : "Best: ") << PointName(*out.best) << "</h2>\n<p><code>" << HtmlEscape(ReproduceText(sweep, ranked.front()))
          << "</code></p>\n";
   }
   for (size_t k = 0; k < spec.axes.size(); ++k) {

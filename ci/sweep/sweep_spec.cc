@@ -10,6 +10,7 @@
 #include "common/error.h"
 #include "common/json_reader.h"
 #include "common/paths.h"
+#include "ci/sweep/sweep_pose.h"
 #include "sequence_format/calibration.h"
 #include "sim/camera/rig.h"
 #include "sim/scene/mesh.h"
@@ -197,9 +198,13 @@ struct Gaussian {
 // 0.6 of the previous generation's (the elite of a small population would
 // otherwise collapse it before the mean arrives), at least 0.02.
 std::vector<double> SearchUnit(const SweepSpec& spec, int index, const PointMetric& metric_of) {
-  const size_t dims = 2 * spec.axes.size();
+  size_t dims = 0;
+  for (const SweepAxis& axis : spec.axes) {
+    const auto* pose = std::get_if<PoseAxis>(&axis.axis);
+    dims += pose ? pose->dims.size() : 2;
+  }
   const int generation = index / spec.population;
-  const double sign = HigherIsBetter(spec.metric) ? -1 : 1;  // smaller is better below
+  const double sign = SeeksHigh(spec) ? -1 : 1;  // smaller is better below
   Gaussian dist{std::vector<double>(dims, 0.5), std::vector<double>(dims, 0.4)};
   std::vector<std::pair<double, std::vector<double>>> done;  // (signed metric, unit coordinates)
   for (int g = 0; g <= generation; ++g) {
@@ -229,6 +234,11 @@ std::vector<double> SearchUnit(const SweepSpec& spec, int index, const PointMetr
 
 size_t AxisSize(const SweepAxis& axis) {
   if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) return size_t(p->steps) * p->height.steps;
+  if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
+    size_t n = 1;
+    for (const PoseDim& d : pose->dims) n *= size_t(d.range.steps);
+    return n;
+  }
   return std::get<ValueAxis>(axis.axis).values.size();
 }
 
@@ -256,9 +266,10 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   const Scenario base_scenario = ScenarioOf(spec.base, file);  // checks the base's keys
   spec.inputs = ScenarioInputFiles(base_scenario.render);       // and its files
   spec.mode = root.GetString("mode", "grid");
-  if (spec.mode != "grid" && spec.mode != "random" && spec.mode != "search") {
-    root["mode"].Fail("expected \"grid\", \"random\" or \"search\"");
+  if (spec.mode != "grid" && spec.mode != "random" && spec.mode != "search" && spec.mode != "adversarial") {
+    root["mode"].Fail("expected \"grid\", \"random\", \"search\" or \"adversarial\"");
   }
+  const bool searches = spec.mode == "search" || spec.mode == "adversarial";
   spec.seed = static_cast<uint64_t>(root.GetInt("seed", 1));
   if (spec.mode == "random") {
     spec.samples = root.GetInt("samples");
@@ -266,10 +277,10 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   } else if (root.Has("samples")) {
     root["samples"].Fail("only for mode \"random\"");
   }
-  if (spec.mode == "search") {
+  if (searches) {
     ReadSearch(root["search"], &spec);
   } else if (root.Has("search")) {
-    root["search"].Fail("only for mode \"search\"");
+    root["search"].Fail("only for modes \"search\" and \"adversarial\"");
   }
   spec.metric = root.GetString("metric", "arms_mean_cm");
   const auto& metrics = KnownMetrics();
@@ -283,8 +294,8 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   // Value axes first: a placement is checked against every rig a point may have.
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
-    if (a.Has("camera")) continue;
-    if (spec.mode == "search") a.Fail("mode \"search\" moves cameras only: give other values in the base");
+    if (a.Has("camera") || a.Has("pose")) continue;
+    if (searches) a.Fail("a search moves cameras and poses only: give other values in the base");
     a.CheckKeys({"key", "values"});
     ValueAxis v;
     v.key = a.GetString("key");
@@ -312,6 +323,14 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   std::vector<SweepAxis> placements;
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
+    if (a.Has("pose")) {
+      const std::string name = a.GetString("pose");
+      if (const std::string problem = CameraNameProblem(name); !problem.empty()) a["pose"].Fail(problem);
+      if (!names.insert(name).second) a["pose"].Fail("'" + name + "' is swept twice");
+      if (names.count("motion")) a["pose"].Fail("a pose is the point's motion: the spec also sweeps `motion`");
+      placements.push_back({name, ReadPoseAxis(a, spec.mode == "grid")});
+      continue;
+    }
     if (!a.Has("camera")) continue;
     PlacementAxis p = ReadPlacement(a, spec.mode == "grid");
     if (!names.insert(p.camera).second) a["camera"].Fail("camera '" + p.camera + "' is placed twice");
@@ -324,7 +343,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   if (spec.mode == "grid") {
     for (const SweepAxis& axis : spec.axes) count *= double(AxisSize(axis));
   }
-  if (spec.mode == "search") count = double(spec.population) * spec.generations;
+  if (searches) count = double(spec.population) * spec.generations;
   if (count > kMaxPoints) axes.Fail("a grid of " + std::to_string(count) + " points (at most 1000000)");
   spec.canonical = root.raw().dump(2) + "\n";
   return spec;
@@ -332,17 +351,19 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
 
 int PointCount(const SweepSpec& spec) {
   if (spec.mode == "random") return spec.samples;
-  if (spec.mode == "search") return spec.population * spec.generations;
+  if (spec.mode == "search" || spec.mode == "adversarial") return spec.population * spec.generations;
   size_t count = 1;
   for (const SweepAxis& axis : spec.axes) count *= AxisSize(axis);
   return static_cast<int>(count);
 }
 
 int GenerationOf(const SweepSpec& spec, int index) {
-  return spec.mode == "search" ? index / spec.population : 0;
+  return spec.population > 0 ? index / spec.population : 0;
 }
 
-int GenerationCount(const SweepSpec& spec) { return spec.mode == "search" ? spec.generations : 1; }
+int GenerationCount(const SweepSpec& spec) { return spec.population > 0 ? spec.generations : 1; }
+
+bool SeeksHigh(const SweepSpec& spec) { return HigherIsBetter(spec.metric) != (spec.mode == "adversarial"); }
 
 SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_of) {
   if (index < 0 || index >= PointCount(spec)) {
@@ -352,13 +373,18 @@ SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_o
   SweepPoint point;
   point.index = index;
   point.at.resize(spec.axes.size());
-  if (spec.mode == "search") {
+  if (spec.population > 0) {
     const std::vector<double> unit = SearchUnit(spec, index, metric_of);
+    size_t u = 0;
     for (size_t k = 0; k < spec.axes.size(); ++k) {
-      const auto& p = std::get<PlacementAxis>(spec.axes[k].axis);
       AxisValue& at = point.at[k];
-      at.along = unit[2 * k];
-      at.height = p.height.from + (p.height.to - p.height.from) * unit[2 * k + 1];
+      if (const auto* pose = std::get_if<PoseAxis>(&spec.axes[k].axis)) {
+        for (const PoseDim& d : pose->dims) at.pose.push_back(d.range.from + (d.range.to - d.range.from) * unit[u++]);
+        continue;
+      }
+      const auto& p = std::get<PlacementAxis>(spec.axes[k].axis);
+      at.along = unit[u++];
+      at.height = p.height.from + (p.height.to - p.height.from) * unit[u++];
       at.position = PlacementPosition(p, at.along, at.height);
     }
     return point;
@@ -373,7 +399,19 @@ SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_o
       cell = rest % AxisSize(axis);
       rest /= AxisSize(axis);
     }
-    if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
+    if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
+      // Grid: the cell's steps, the last dim fastest; random: anywhere.
+      at.pose.resize(pose->dims.size());
+      for (size_t d = pose->dims.size(); d-- > 0;) {
+        const SweepRange& r = pose->dims[d].range;
+        if (grid) {
+          at.pose[d] = r.At(static_cast<int>(cell % r.steps));
+          cell /= r.steps;
+        } else {
+          at.pose[d] = r.from + (r.to - r.from) * Uniform(spec.seed, index, k, static_cast<int>(d));
+        }
+      }
+    } else if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
       if (grid) {
         at.along_step = static_cast<int>(cell % p->steps);
         at.height_step = static_cast<int>(cell / p->steps);
@@ -398,7 +436,11 @@ nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point) 
   for (size_t k = 0; k < spec.axes.size(); ++k) {
     const SweepAxis& axis = spec.axes[k];
     const AxisValue& at = point.at[k];
-    if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+    if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
+      for (size_t d = 0; d < pose->dims.size(); ++d) {
+        out[axis.name + "." + pose->dims[d].joint + "." + "xyz"[pose->dims[d].component]] = at.pose[d];
+      }
+    } else if (std::holds_alternative<PlacementAxis>(axis.axis)) {
       out[axis.name + ".along"] = at.along;
       out[axis.name + ".height"] = at.height;
       out[axis.name + ".position"] = {at.position.x(), at.position.y(), at.position.z()};
@@ -409,12 +451,25 @@ nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point) 
   return out;
 }
 
-Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs::path& rigs) {
+Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs::path& out) {
+  const fs::path rigs = out / "rigs";
   nlohmann::json keys = spec.base;
   bool moved = false;
   for (size_t k = 0; k < spec.axes.size(); ++k) {
     if (const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis)) keys = WithValue(keys, v->key, point.at[k].value);
     moved |= std::holds_alternative<PlacementAxis>(spec.axes[k].axis);
+    if (const auto* pose = std::get_if<PoseAxis>(&spec.axes[k].axis)) {
+      const fs::path file = fs::absolute(out / "motions" / (PointName(point.index) + ".json"));
+      nlohmann::json held = nlohmann::json::object();
+      for (size_t d = 0; d < pose->dims.size(); ++d) {
+        held[pose->dims[d].joint + "." + "xyz"[pose->dims[d].component]] = point.at[k].pose[d];
+      }
+      WritePoseMotion(*pose, point.at[k].pose, spec.name + "-" + PointName(point.index),
+                      "Sweep " + spec.name + " point " + std::to_string(point.index) + ", pose " + spec.axes[k].name +
+                          " (degrees, docs/formats.md): " + held.dump(),
+                      file);
+      keys["motion"] = file.string();
+    }
   }
   if (moved) {
     // The point's rig: the base rig's file with the placed cameras moved.

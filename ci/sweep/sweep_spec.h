@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -42,6 +43,21 @@ struct PlacementAxis {
   Eigen::Vector3d up = Eigen::Vector3d(0, 0, 1);
 };
 
+// An arm pose held (sweep_pose.h): joint rotations in the keyframe
+// convention (docs/formats.md: [x, y, z] degrees, ZXY), each component fixed
+// or a range; a point's motion stands, moves into the pose in `move_s`,
+// holds it `hold_s`.
+struct PoseDim {
+  std::string joint;
+  int component = 0;  // 0 x, 1 y, 2 z
+  SweepRange range;
+};
+struct PoseAxis {
+  std::map<std::string, Eigen::Vector3d> fixed;  // every listed joint's components, ranges at their `from`
+  std::vector<PoseDim> dims;                     // the ranged components
+  double move_s = 1.0, hold_s = 2.0;
+};
+
 // A scenario key (`rig`, `motion`, `track.rest_model` ...) taking each value.
 struct ValueAxis {
   std::string key;
@@ -50,7 +66,7 @@ struct ValueAxis {
 
 struct SweepAxis {
   std::string name;  // the camera's name or the key
-  std::variant<PlacementAxis, ValueAxis> axis;
+  std::variant<PlacementAxis, ValueAxis, PoseAxis> axis;
 };
 
 struct SweepSpec {
@@ -58,7 +74,7 @@ struct SweepSpec {
   std::filesystem::path file;
   nlohmann::json base;  // the base scenario's keys as written
   std::vector<SweepAxis> axes;
-  std::string mode = "grid";  // grid | random | search
+  std::string mode = "grid";  // grid | random | search | adversarial (a search for the worst)
   int samples = 0;            // random: points
   uint64_t seed = 1;          // random, search: the sampler's seed
   // search (the cross-entropy method): `population` points per generation,
@@ -78,6 +94,7 @@ struct AxisValue {
   int along_step = -1, height_step = -1;  // grid: the steps; random: -1
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   nlohmann::json value;  // value axis
+  std::vector<double> pose;  // pose axis: per dim, degrees
 };
 
 struct SweepPoint {
@@ -114,10 +131,15 @@ SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_o
 nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point);
 
 // The point's scenario: the base with the point's values; a placement writes
-// the moved rig to <rigs>/pNNNN.json (that file renders the point alone).
-Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const std::filesystem::path& rigs);
+// the moved rig to <out>/rigs/pNNNN.json, a pose its motion to
+// <out>/motions/pNNNN.json (those files render the point alone).
+Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const std::filesystem::path& out);
 
 // "p0007"
 std::string PointName(int index);
+
+// Whether the mode seeks high values of the metric: a search seeks the best
+// (high for fractions, low for errors), `adversarial` the worst.
+bool SeeksHigh(const SweepSpec& spec);
 
 }  // namespace irbench

@@ -63,7 +63,7 @@ TEST(SweepSpecTest, GridVisitsEveryCombinationOnceAtTheAnalyticPlaces) {
 TEST(SweepSpecTest, PointRigHasTheCameraWhereThePointSays) {
   const SweepSpec spec = LoadSweepSpec(Write("rig.json", GridSpec()));
   const SweepPoint p = PointAt(spec, 7);
-  const Scenario sc = PointScenario(spec, p, Dir() / "rigs");
+  const Scenario sc = PointScenario(spec, p, Dir());
   EXPECT_EQ(sc.render.avatar, p.at[1].value.get<std::string>());
   EXPECT_EQ(fs::path(sc.render.rig).filename(), "p0007.json");
   const Rig moved = LoadRig(sc.render.rig);

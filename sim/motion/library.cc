@@ -504,6 +504,43 @@ MotionPtr AtomTour(const nlohmann::json& params, Builder& b) {
   return b.Standing("atom_tour", keys, {});
 }
 
+// The self-occluding poses of thesis Fig. 6.10 and their kin, held: the
+// `side` arm (default the dominant one) and, where the pose takes both, the
+// other. Wrist targets relative to the shoulder, chest frame (x = the
+// person's right, y forward, z up).
+MotionPtr Occlusion(const nlohmann::json& params, Builder& b) {
+  const std::string pose = StringParam(params, "pose", "arm_across", b);
+  const int d = SideParam(params, b), o = -d;
+  const double hold = Param(params, "hold_s", 2.0, b, 0.0, 60.0);
+  const Skeleton& sk = b.sk_;
+  ArmKey held{b.T(1.0), b.Rest(1), b.Rest(-1)};
+  ArmPose& lead = d > 0 ? held.right : held.left;
+  ArmPose& other = d > 0 ? held.left : held.right;
+  const auto pole = [](int side) { return Eigen::Vector3d(0.6 * side, -0.3, -1.0); };
+  if (pose == "arm_across") {
+    // Fig. 6.10, left: the arm level across the chest, the hand in front of
+    // the other shoulder: over the torso in the frontal views.
+    lead = ArmReach(d, sk, Eigen::Vector3d(-0.24 * d, 0.30, -0.05), pole(d));
+  } else if (pose == "arms_crossed") {
+    // Fig. 6.10, right: the forearms cross in front of the chest, the
+    // `side` arm in front of the other.
+    lead = ArmReach(d, sk, Eigen::Vector3d(-0.42 * d, 0.38, -0.12), pole(d));
+    other = ArmReach(o, sk, Eigen::Vector3d(-0.40 * o, 0.24, -0.20), pole(o));
+  } else if (pose == "hands_together") {
+    lead = ArmReach(d, sk, Eigen::Vector3d(-0.17 * d, 0.33, -0.12), pole(d));
+    other = ArmReach(o, sk, Eigen::Vector3d(-0.17 * o, 0.33, -0.12), pole(o));
+  } else if (pose == "arm_behind") {
+    // The hand at the small of the back: hidden from the frontal cameras.
+    lead = ArmReach(d, sk, Eigen::Vector3d(-0.16 * d, -0.20, -0.42), Eigen::Vector3d(1.0 * d, -0.5, 0.0));
+  } else {
+    b.Fail("pose", "unknown pose '" + pose + "' (arm_across, arms_crossed, hands_together, arm_behind)");
+  }
+  std::vector<ArmKey> keys = {{0.0, b.Rest(1), b.Rest(-1)}, held};
+  keys.push_back({held.t + b.T(hold), held.right, held.left});
+  keys.push_back({keys.back().t + b.T(1.0), b.Rest(1), b.Rest(-1)});
+  return b.Standing("occlusion_" + pose, keys, {}, d);
+}
+
 MotionPtr PointAt(const nlohmann::json& params, Builder& b) {
   const int d = SideParam(params, b);
   const std::string target = StringParam(params, "target", "", b);
@@ -682,6 +719,7 @@ std::vector<std::pair<std::string, std::string>> LibraryMotions() {
       {"posture", "an atom posture per arm, held (right, left: A0..A4; hold_s)"},
       {"atom_tour", "every two-arm atom combination in turn (15 postures)"},
       {"story", "natural story-telling hand motions covering the nine motion labels"},
+      {"occlusion", "a self-occluding pose held (pose: arm_across, arms_crossed, hands_together, arm_behind; side)"},
       {"rest", "stand at rest (seconds)"},
       {"crouch", "crouch down and stand up (depth_deg, hold_s)"},
       {"walk", "walk to a point on the stage (to: [x, y]; heading_deg at the end)"},
@@ -769,6 +807,10 @@ MotionPtr BuildLibraryMotion(const std::string& name, const nlohmann::json& para
   if (name == "story") {
     CheckKeys(params, {"side"}, b);
     return Story(params, b);
+  }
+  if (name == "occlusion") {
+    CheckKeys(params, {"pose", "side", "hold_s"}, b);
+    return Occlusion(params, b);
   }
   if (name == "rest") {
     CheckKeys(params, {"seconds"}, b);
