@@ -42,6 +42,7 @@ void PrintCollected(const SweepCollected& c) {
   std::cout << c.done << " of " << c.total << " points done";
   if (c.best) std::cout << "; best " << PointName(*c.best);
   std::cout << "\n  " << c.md.string() << "\n  " << c.csv.string() << "\n  " << c.html.string() << "\n";
+  if (!c.suite.empty()) std::cout << "  " << c.suite.string() << " (the hardest points as a suite)\n";
 }
 
 int RunCommand(const CLI::App& cmd, SweepArgs& args) {

@@ -62,12 +62,14 @@ struct SweepCollected {
   std::vector<int> missing;
   std::optional<int> best;  // the best point by the spec's metric
   std::filesystem::path csv, md, html;
+  std::filesystem::path suite;  // adversarial: OUT/suite.json, the 5 hardest points as a suite
 };
 
 // Writes OUT/sweep.csv (a row per finished point: index, coordinates, every
 // metric), OUT/sweep.md (points ranked by the spec's metric, the metric per
 // value of each axis) and OUT/report.html (the same with placement heat maps
-// and links to each point's report.html).
+// and links to each point's report.html); an adversarial sweep also
+// OUT/suite.json, its 5 hardest points as a suite (`irbench suite run`).
 SweepCollected CollectSweep(const SweepOptions& options);
 
 struct SlurmOptions {

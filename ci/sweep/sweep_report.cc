@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "ci/report/report.h"
@@ -259,12 +260,17 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
     ++c.n;
   }
   if (cells.empty()) return "";
-  double lo = 1e300, hi = -1e300;
-  for (const auto& [key, c] : cells) {
-    lo = std::min(lo, c.sum / c.n);
-    hi = std::max(hi, c.sum / c.n);
-  }
+  // Colour by rank (one outlier would wash out a linear scale).
+  std::vector<double> values;
+  for (const auto& [key, c] : cells) values.push_back(c.sum / c.n);
+  std::sort(values.begin(), values.end());
+  const double lo = values.front(), hi = values.back();
   const bool higher = HigherIsBetter(spec.metric);
+  const auto badness = [&](double v) {
+    if (values.size() < 2) return 0.0;
+    const double rank = double(std::lower_bound(values.begin(), values.end(), v) - values.begin()) / (values.size() - 1);
+    return higher ? 1 - rank : rank;
+  };
   const double w = 480, h = 240, left = 60, top = 20, bottom = 50;
   const double hmin = std::min(p.height.from, p.height.to), hmax = std::max(p.height.from, p.height.to);
   const int cols = spec.mode == "grid" ? p.steps : 1, rows = spec.mode == "grid" ? p.height.steps : 1;
@@ -273,7 +279,7 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
       << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
   for (const auto& [key, c] : cells) {
     const double v = c.sum / c.n;
-    const double bad = hi > lo ? (higher ? (hi - v) / (hi - lo) : (v - lo) / (hi - lo)) : 0.0;
+    const double bad = badness(v);
     char colour[32];
     std::snprintf(colour, sizeof(colour), "rgb(%d,%d,70)", int(40 + 200 * bad), int(190 - 150 * bad));
     const double fx = c.along, fy = hmax > hmin ? (c.height - hmin) / (hmax - hmin) : 0.5;
@@ -293,7 +299,7 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
       << Short(a.y()) << ")</text><text x=\"" << left + w << "\" y=\"" << top + h + 18
       << "\" text-anchor=\"end\">(" << Short(b.x()) << ", " << Short(b.y()) << ")</text>\n"
       << "<text x=\"" << left + w / 2 << "\" y=\"" << top + h + 38 << "\" text-anchor=\"middle\">camera " << p.camera
-      << ": " << spec.metric << " (green best: " << Short(higher ? hi : lo) << ", red worst: "
+      << ": " << spec.metric << ", coloured by rank (green best: " << Short(higher ? hi : lo) << ", red worst: "
       << Short(higher ? lo : hi) << ")</text>\n"
       << "<text x=\"" << left - 6 << "\" y=\"" << top + h << "\" text-anchor=\"end\">" << Short(hmin)
       << " m</text><text x=\"" << left - 6 << "\" y=\"" << top + 10 << "\" text-anchor=\"end\">" << Short(hmax)
@@ -337,6 +343,41 @@ std::string ReproduceText(const SweepContext& sweep, const Done& best) {
       << (r.frames ? " --frames " + std::to_string(*r.frames) : std::string()) << " --background-frames "
       << r.background_frames << " --out best && irbench track best && irbench score best";
   return out.str();
+}
+
+// A suite of the first `count` ranked points (an adversarial sweep's hardest
+// poses), each scenario the point's render inputs with its saved motion and
+// rig; a loose guard on its arms error (1.5 x the point's). Motion files are
+// relative to the suite (in OUT beside motions/).
+std::string HardestSuite(const SweepContext& sweep, const std::vector<Done>& ranked, size_t count) {
+  nlohmann::json scenarios = nlohmann::json::array();
+  for (size_t r = 0; r < std::min(count, ranked.size()); ++r) {
+    const Done& d = ranked[r];
+    const auto arms = d.metrics.find("arms_mean_cm");
+    if (arms == d.metrics.end()) continue;
+    const RenderJobOptions render = PointScenario(sweep.spec, d.point, sweep.out).render;
+    const fs::path motion(render.motion);
+    nlohmann::json sc = {{"name", sweep.spec.name + "_" + PointName(d.index)},
+                         {"rig", render.rig},
+                         {"avatar", render.avatar},
+                         {"motion", motion.parent_path() == fs::absolute(sweep.out / "motions")
+                                        ? "motions/" + motion.filename().string()
+                                        : render.motion},
+                         {"sensor", render.sensor},
+                         {"seed", render.seed},
+                         {"background_frames", render.background_frames},
+                         {"thresholds", {{"arms_mean_cm", {{"max", std::ceil(1.5 * arms->second)}, {"tolerance", 1.0}}}}}};
+    if (!render.scene.empty()) sc["scene"] = render.scene;
+    if (render.frames) sc["frames"] = *render.frames;
+    scenarios.push_back(sc);
+  }
+  const nlohmann::json suite = {
+      {"format", "irbench.suite/1"},
+      {"name", sweep.spec.name + "_hardest"},
+      {"description", "The " + std::to_string(scenarios.size()) + " hardest points of sweep " + sweep.spec.name +
+                          " by " + sweep.spec.metric + ", written by `irbench sweep collect`."},
+      {"scenarios", scenarios}};
+  return suite.dump(2) + "\n";
 }
 
 }  // namespace
@@ -399,6 +440,10 @@ SweepCollected CollectSweep(const SweepOptions& options) {
          << " " << Value(*it, spec.metric) << "</li>\n";
   }
   html << "</ul>\n</body></html>\n";
+  if (spec.mode == "adversarial" && !ranked.empty()) {
+    out.suite = sweep.out / "suite.json";
+    AtomicWriteFile(out.suite, HardestSuite(sweep, ranked, 5));
+  }
   out.html = sweep.out / "report.html";
   AtomicWriteFile(out.html, html.str());
   return out;
