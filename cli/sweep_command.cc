@@ -1,11 +1,13 @@
 // `irbench sweep run|run-one|submit|collect`: stress sweeps over camera
 // placements and scenario values, here or on a Slurm cluster.
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "ci/sweep/sweep.h"
+#include "common/paths.h"
 #include "cli/commands.h"
 #include "cli/option_checks.h"
 
@@ -25,15 +27,16 @@ struct SweepArgs {
 void Bind(const CLI::App& cmd, SweepArgs& args) {
   RequireNotEmpty(cmd, "--out", args.out);
   RequireNotEmpty(cmd, "--cache", args.cache);
-  args.job.spec = args.spec;
+  // A file, or a name in ci/sweeps/ (`side_camera`).
+  args.job.spec = std::filesystem::is_regular_file(args.spec) ? std::filesystem::path(args.spec)
+                                                             : ResolveDataFile("ci/sweeps", args.spec, "SPEC");
   args.job.out = args.out;
   args.job.cache = args.cache;
 }
 
 void AddCommon(CLI::App* cmd, SweepArgs& args) {
-  cmd->add_option("SPEC", args.spec, "sweep spec file (irbench.sweep/1; docs/sweeps.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  cmd->add_option("SPEC", args.spec, "sweep spec: a file (irbench.sweep/1; docs/sweeps.md) or a name in ci/sweeps/")
+      ->required();
   cmd->add_option("--out", args.out, "sweep folder: points, rigs, tables, report (default: renders/sweeps/<name>)");
   cmd->add_option("--cache", args.cache, "render cache folder, seen by every node (default: renders/cache)");
 }

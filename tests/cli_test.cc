@@ -28,22 +28,8 @@ using irbench::testing::WriteText;
 
 const std::string kIrbench = std::string(IRBENCH_BINARY_DIR) + "/irbench";
 
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-Result RunIrbench(const std::vector<std::string>& args, const fs::path& dir) {
-  std::string command = kIrbench;
-  for (const std::string& a : args) command += " '" + a + "'";
-  command += " > '" + (dir / "stdout.txt").string() + "' 2> '" + (dir / "stderr.txt").string() + "'";
-  const int status = std::system(command.c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadText(dir / "stdout.txt");
-  r.err = ReadText(dir / "stderr.txt");
-  return r;
-}
+using irbench::testing::Result;
+using irbench::testing::RunIrbench;
 
 // Entries of `dir` other than the captured output files.
 std::vector<std::string> Leftovers(const fs::path& dir) {

@@ -23,22 +23,8 @@ using testing::FreshTempDir;
 using testing::ReadText;
 using testing::WriteText;
 
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-Result RunIrbench(const std::vector<std::string>& args, const fs::path& dir) {
-  std::string command = std::string(IRBENCH_BINARY_DIR) + "/irbench";
-  for (const std::string& a : args) command += " '" + a + "'";
-  command += " > '" + (dir / "stdout.txt").string() + "' 2> '" + (dir / "stderr.txt").string() + "'";
-  const int status = std::system(command.c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadText(dir / "stdout.txt");
-  r.err = ReadText(dir / "stderr.txt");
-  return r;
-}
+using irbench::testing::Result;
+using irbench::testing::RunIrbench;
 
 TEST(SweepTest, RunsResumesRunsOnePointAloneAndReproducesTheBest) {
   const fs::path dir = FreshTempDir("sweep");
@@ -110,6 +96,15 @@ TEST(SweepTest, RunsResumesRunsOnePointAloneAndReproducesTheBest) {
   const nlohmann::json& expected = (best == 0 ? j0 : j1)["metrics"];
   ASSERT_EQ(m.metrics.size(), expected.size());
   for (const auto& [metric, value] : m.metrics) EXPECT_EQ(value, expected[metric].get<double>()) << metric;
+  // A bad spec: exit 2, one line naming the file and field, nothing written or submitted.
+  WriteText(dir / "bad.json", R"({"format": "irbench.sweep/1", "name": "bad", "base": {},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, 0], "to": [-9, 0], "steps": 2}, "height": 2}]})");
+  const Result bad = RunIrbench({"sweep", "submit", (dir / "bad.json").string(), "--out", (dir / "bad").string(),
+                                 "--cache", cache.string(), "--sbatch", "/bin/false"}, dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find((dir / "bad.json").string() + ": axes[0].along: camera at (-9, 0, 2) lies outside"),
+            std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
   // Another spec into the same folder is refused, naming --out.
   WriteText(spec, ReadText(spec).replace(ReadText(spec).find("\"seed\": 4"), 9, "\"seed\": 5"));
   const Result other = RunIrbench(with({"sweep", "run", spec.string()}), dir);

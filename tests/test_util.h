@@ -1,8 +1,11 @@
 #pragma once
 // Helpers shared by the closed-loop tests.
 
+#include <sys/wait.h>
+
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,6 +14,30 @@
 #include <vector>
 
 namespace irbench::testing {
+
+// What the irbench program did: its exit code and what it printed.
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string ReadText(const std::filesystem::path& path);
+
+#ifdef IRBENCH_BINARY_DIR
+// Runs the built irbench with `args` (each quoted) in the shell, its stdout
+// and stderr captured through files in `dir`.
+inline Result RunIrbench(const std::vector<std::string>& args, const std::filesystem::path& dir) {
+  std::string command = std::string(IRBENCH_BINARY_DIR) + "/irbench";
+  for (const std::string& a : args) command += " '" + a + "'";
+  command += " > '" + (dir / "stdout.txt").string() + "' 2> '" + (dir / "stderr.txt").string() + "'";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadText(dir / "stdout.txt");
+  r.err = ReadText(dir / "stderr.txt");
+  return r;
+}
+#endif
 
 inline std::filesystem::path FreshTempDir(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("irbench_test_" + name);

@@ -14,6 +14,7 @@
 
 #include "common/error.h"
 #include "sim/camera/rig.h"
+#include "sim/motion/keyframes.h"
 
 namespace irbench {
 namespace {
@@ -145,6 +146,70 @@ TEST(SweepSpecTest, SearchClosesInOnTheBestPlacement) {
     EXPECT_LE(at.along, 1.0);
     EXPECT_GE(at.height, 1.0);
     EXPECT_LE(at.height, 3.0);
+  }
+}
+
+// Adversarial: the same search seeking the worst moves away from the target.
+TEST(SweepSpecTest, AdversarialSearchSeeksTheWorst) {
+  const SweepSpec spec = LoadSweepSpec(Write("adversarial.json", R"({"format": "irbench.sweep/1", "name": "a",
+    "base": {"rig": "theater4", "motion": "wave", "frames": 3}, "mode": "adversarial", "seed": 3,
+    "search": {"population": 6, "generations": 4, "elite": 2},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -2.0], "to": [-3.6, 2.0]},
+              "height": {"from": 1.0, "to": 3.0}}]})"));
+  EXPECT_FALSE(SeeksHigh(LoadSweepSpec(Write("s2.json", R"({"format": "irbench.sweep/1", "name": "s",
+    "base": {}, "mode": "search", "search": {"population": 2, "generations": 1},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -2.0], "to": [-3.6, 2.0]}, "height": 2}]})"))));
+  EXPECT_TRUE(SeeksHigh(spec));  // the worst arms error: the highest
+  const Eigen::Vector3d target(-3.6, 0.0, 2.0);  // the middle: the worst points are at the corners
+  std::map<int, double> memo;
+  PointMetric metric_of;
+  metric_of = [&](int i) -> std::optional<double> {
+    if (!memo.count(i)) memo[i] = (PointAt(spec, i, metric_of).at[0].position - target).norm();
+    return memo[i];
+  };
+  double first = 0, last = 0;
+  for (int i = 0; i < 6; ++i) first = std::max(first, *metric_of(i));
+  for (int i = 18; i < 24; ++i) last = std::max(last, *metric_of(i));
+  EXPECT_GT(last, first);
+  EXPECT_GT(last, 0.9 * std::hypot(2.0, 1.0));  // near a corner: 2 m along, 1 m up or down
+}
+
+// A pose point's motion: a keyframe file the motion reader takes, standing
+// at 0 and holding the point's angles from move_s to move_s + hold_s.
+TEST(SweepSpecTest, PosePointIsAKeyframeMotionHoldingItsAngles) {
+  const SweepSpec spec = LoadSweepSpec(Write("pose.json", R"({"format": "irbench.sweep/1", "name": "p",
+    "base": {"rig": "theater4"}, "mode": "random", "samples": 3, "seed": 5,
+    "axes": [{"pose": "arms", "move_s": 0.5, "hold_s": 1.5,
+              "joints": {"right_shoulder": [0, {"from": -40, "to": 60}, {"from": 20, "to": 150}],
+                         "left_elbow": [0, 0, {"from": -130, "to": 0}]}}]})"));
+  const SweepPoint p = PointAt(spec, 2);
+  const auto& dims = std::get<PoseAxis>(spec.axes[0].axis).dims;
+  ASSERT_EQ(p.at[0].pose.size(), 3u);
+  std::map<std::string, double> angle;  // "right_shoulder.z" -> degrees
+  for (size_t d = 0; d < dims.size(); ++d) angle[dims[d].joint + "." + "xyz"[dims[d].component]] = p.at[0].pose[d];
+  ASSERT_EQ(angle.size(), 3u);
+  EXPECT_GE(angle["right_shoulder.z"], 20.0);
+  EXPECT_LE(angle["right_shoulder.z"], 150.0);
+  EXPECT_GE(angle["left_elbow.z"], -130.0);
+  EXPECT_LE(angle["left_elbow.z"], 0.0);
+  const Scenario sc = PointScenario(spec, p, Dir() / "pose_out");
+  EXPECT_EQ(fs::path(sc.render.motion), fs::absolute(Dir() / "pose_out" / "motions" / "p0002.json"));
+  const KeyframeMotion motion = LoadKeyframes(sc.render.motion);
+  EXPECT_DOUBLE_EQ(motion.Duration(), 2.0);
+  const nlohmann::json file = nlohmann::json::parse(std::ifstream(sc.render.motion));
+  const nlohmann::json& held = file["keys"][1]["joints"];
+  EXPECT_DOUBLE_EQ(held["right_shoulder"][1].get<double>(), angle["right_shoulder.y"]);
+  EXPECT_DOUBLE_EQ(held["right_shoulder"][2].get<double>(), angle["right_shoulder.z"]);
+  EXPECT_DOUBLE_EQ(held["left_elbow"][2].get<double>(), angle["left_elbow.z"]);
+  EXPECT_EQ(file["keys"][2]["joints"], held);
+  EXPECT_EQ(file["keys"][0]["joints"]["right_shoulder"], nlohmann::json({0.0, 80.0, 0.0}));  // standing
+  // Unknown joints and out-of-range angles are refused naming the field.
+  try {
+    LoadSweepSpec(Write("pose_bad.json", R"({"format": "irbench.sweep/1", "name": "p", "base": {},
+      "axes": [{"pose": "arms", "joints": {"right_knuckle": [0, 0, {"from": 0, "to": 10, "steps": 2}]}}]})"));
+    ADD_FAILURE() << "accepted an unknown joint";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "axes[0].joints.right_knuckle");
   }
 }
 
