@@ -201,6 +201,7 @@ SweepRun RunSweep(const SweepOptions& options, std::optional<int> only) {
   Progress progress("sweep " + sweep.spec.name, "points", static_cast<int>(todo.size()));
   progress.IgnoreQuiet();
   std::mutex mutex, render_mutex;
+  std::exception_ptr interrupted;
   // A generation at a time: a search's points need the generations before.
   for (int g = 0, generations = GenerationCount(sweep.spec); g < generations && run.failed.empty(); ++g) {
     std::vector<int> now;
@@ -213,6 +214,12 @@ SweepRun RunSweep(const SweepOptions& options, std::optional<int> only) {
         std::string why;
         try {
           RunPoint(sweep, now[i], &render_mutex);
+        } catch (const Cancelled&) {
+          // Ctrl-C: start no more points; the finished ones stay.
+          const std::lock_guard<std::mutex> lock(mutex);
+          if (!interrupted) interrupted = std::current_exception();
+          next = now.size();
+          return;
         } catch (const std::exception& e) {
           why = e.what();
           Log().error("sweep {}: {} failed: {}", sweep.spec.name, PointName(now[i]), why);
@@ -231,6 +238,7 @@ SweepRun RunSweep(const SweepOptions& options, std::optional<int> only) {
     for (size_t w = 1; w < pool_size; ++w) pool.emplace_back(work);
     if (pool_size > 0) work();
     for (std::thread& t : pool) t.join();
+    if (interrupted) std::rethrow_exception(interrupted);
     if (only) break;
   }
   std::sort(run.failed.begin(), run.failed.end());
