@@ -3,8 +3,9 @@
 // fuzz/json.dict.
 //
 // The reader, ReadSuite, is private to suite.cc and RunSuite goes on to render
-// and track every scenario, so this file compiles suite.cc itself to call it
-// (the harness does not link irbench::suite). When suite.h exposes the reader,
+// and track every scenario, so this file compiles suite.cc (and scenario.cc,
+// which reads each scenario's keys) itself to call it (the harness does not
+// link irbench::suite). When suite.h exposes the reader,
 // call that instead.
 #include <cstddef>
 #include <cstdint>
@@ -12,7 +13,8 @@
 #include <string>
 #include <string_view>
 
-#include "ci/suite_runner/suite.cc"  // NOLINT(bugprone-suspicious-include): see above
+#include "ci/suite_runner/scenario.cc"  // NOLINT(bugprone-suspicious-include): what suite.cc calls
+#include "ci/suite_runner/suite.cc"     // NOLINT(bugprone-suspicious-include): see above
 #include "fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
