@@ -111,6 +111,19 @@ TEST(SweepSpecTest, RandomPointsAreInRangeAndDependOnlyOnSeedAndIndex) {
   EXPECT_NE(PointAt(a, 0).at[0].along, PointAt(b, 0).at[0].along);
 }
 
+// A known bowl for a search: a point's metric is its first axis's camera's
+// distance from `target`, each point drawn (through the earlier generations'
+// metrics) once.
+struct DistanceFrom {
+  const SweepSpec& spec;
+  Eigen::Vector3d target;
+  std::map<int, double> memo;
+  std::optional<double> operator()(int i) {
+    if (!memo.count(i)) memo[i] = (PointAt(spec, i, [this](int j) { return (*this)(j); }).at[0].position - target).norm();
+    return memo[i];
+  }
+};
+
 // The cross-entropy search on a known bowl (the metric: the camera's distance
 // from a target on its wall): it needs each generation's predecessors, and
 // its generations close in on the target.
@@ -125,12 +138,8 @@ TEST(SweepSpecTest, SearchClosesInOnTheBestPlacement) {
   EXPECT_EQ(GenerationOf(spec, 6), 1);
   EXPECT_THROW(PointAt(spec, 6), RuntimeError);  // generation 1 needs generation 0's metrics
   const Eigen::Vector3d target(-3.6, 1.1, 2.4);
-  std::map<int, double> memo;
-  PointMetric metric_of;
-  metric_of = [&](int i) -> std::optional<double> {
-    if (!memo.count(i)) memo[i] = (PointAt(spec, i, metric_of).at[0].position - target).norm();
-    return memo[i];
-  };
+  DistanceFrom bowl{spec, target, {}};
+  const PointMetric metric_of = [&bowl](int i) { return bowl(i); };
   double first = 1e9, last = 1e9;
   for (int i = 0; i < 6; ++i) first = std::min(first, *metric_of(i));
   for (int i = 30; i < 36; ++i) last = std::min(last, *metric_of(i));
@@ -161,12 +170,8 @@ TEST(SweepSpecTest, AdversarialSearchSeeksTheWorst) {
     "axes": [{"camera": "side", "along": {"from": [-3.6, -2.0], "to": [-3.6, 2.0]}, "height": 2}]})"))));
   EXPECT_TRUE(SeeksHigh(spec));  // the worst arms error: the highest
   const Eigen::Vector3d target(-3.6, 0.0, 2.0);  // the middle: the worst points are at the corners
-  std::map<int, double> memo;
-  PointMetric metric_of;
-  metric_of = [&](int i) -> std::optional<double> {
-    if (!memo.count(i)) memo[i] = (PointAt(spec, i, metric_of).at[0].position - target).norm();
-    return memo[i];
-  };
+  DistanceFrom bowl{spec, target, {}};
+  const PointMetric metric_of = [&bowl](int i) { return bowl(i); };
   double first = 0, last = 0;
   for (int i = 0; i < 6; ++i) first = std::max(first, *metric_of(i));
   for (int i = 18; i < 24; ++i) last = std::max(last, *metric_of(i));
