@@ -12,17 +12,11 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
 namespace {
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // A readable bin width: 1, 2 or 5 times a power of ten, about `span` / 20.
 double BinWidth(double span) {
@@ -98,7 +92,7 @@ void RunGnuplot(const fs::path& gnuplot, const fs::path& workdir, const std::str
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     throw RuntimeError(gnuplot.string() + " failed (exit " + std::to_string(code) + ") on " +
                        (workdir / script_file).string() + ": " +
-                       (code == 127 ? std::string("cannot run it") : ReadText(err)));
+                       (code == 127 ? std::string("cannot run it") : ReadFileBytes(err)));
   }
 }
 
@@ -213,7 +207,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
   for (const std::string& name : names) {
     const fs::path file = workdir / (name + ".svg");
     if (!fs::is_regular_file(file)) throw RuntimeError("gnuplot wrote no " + file.string());
-    svgs[name] = ReadText(file);
+    svgs[name] = ReadFileBytes(file);
   }
   return svgs;
 }

@@ -12,6 +12,7 @@
 #include "ci/score/score_job.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
 #include "common/logging.h"
 #include "common/paths.h"
 #include "sequence_format/manifest.h"
@@ -136,8 +137,7 @@ std::string CacheKey(const RenderJobOptions& r) {
                     (SweepsScreens(r, in) ? "|sweep" : "");
   for (const fs::path& f : {in.rig_file, in.scene_file, in.avatar_file, in.motion_file}) {
     if (f.empty() || !fs::is_regular_file(f)) continue;
-    std::ifstream file(f, std::ios::binary);
-    key += std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    key += ReadFileBytes(f);
   }
   char hex[20];
   std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(Fnv1a64(key)));

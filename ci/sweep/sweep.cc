@@ -16,6 +16,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
 #include "common/json_reader.h"
 #include "common/logging.h"
 #include "common/paths.h"
@@ -24,11 +25,6 @@
 namespace irbench {
 namespace fs = std::filesystem;
 namespace {
-
-std::string ReadAll(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 
 // Runs one point: its scenario rendered (cached), tracked and scored; its
 // point file written last, atomically.
@@ -93,7 +89,7 @@ std::string RunSbatch(const fs::path& sbatch, const fs::path& script, const std:
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw RuntimeError("cannot wait for sbatch");
   }
-  std::string printed = ReadAll(log);
+  std::string printed = ReadFileBytes(log);
   while (!printed.empty() && (printed.back() == '\n' || printed.back() == ' ')) printed.pop_back();
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     throw RuntimeError(sbatch.string() + " refused " + script.string() + ": " + printed);
@@ -142,7 +138,7 @@ SweepContext OpenSweep(const SweepOptions& options) {
     throw InputError("", "--out", "'" + sweep.out.string() + "' holds files irbench did not write (no " +
                                       kOutputMarker + ")");
   }
-  if (fs::is_regular_file(spec_copy) && ReadAll(spec_copy) != sweep.spec.canonical) {
+  if (fs::is_regular_file(spec_copy) && ReadFileBytes(spec_copy) != sweep.spec.canonical) {
     throw InputError("", "--out", "'" + sweep.out.string() + "' holds the points of another spec (" +
                                       spec_copy.string() + "); give another --out or remove it");
   }

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "common/error.h"
+#include "common/text.h"
 #include "sim/body/internal/imported_rig.h"
 #include "sim/body/internal/joint_naming.h"
 
@@ -348,7 +349,7 @@ Rig LoadAssimp(const fs::path& path) {
     throw InputError(file, "file",
                      std::string("not a readable model: ") + importer.GetErrorString());
   }
-  std::string ext = Lower(path.extension().string());
+  std::string ext = AsciiLower(path.extension().string());
   Rig rig;
   rig.format = ext;
   ReadUnit(scene, ext, rig);

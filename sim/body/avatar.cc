@@ -4,6 +4,9 @@
 
 #include <cctype>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
 
 #include "common/json_reader.h"
 #include "sim/body/avatar_import.h"
@@ -362,6 +365,81 @@ Avatar LoadMeshAvatar(const std::filesystem::path& path, const JsonNode& root, c
   return avatar;
 }
 
+// A parametric or tube avatar from its file's JSON: checked, then built.
+Avatar BuildDescribedAvatar(const JsonNode& root, AvatarParams params) {
+  for (const char* key : {"file", "scale", "up_axis", "joint_map"}) {
+    if (root.Has(key)) root[key].Fail("only imported (kind \"mesh\") avatars have it");
+  }
+  params.height_m = root.GetDouble("height_m");
+  if (params.height_m < 1.0 || params.height_m > 2.3) root["height_m"].Fail("must be in 1.0..2.3 m");
+  params.build = root.GetDouble("build", 1.0);
+  if (params.build < 0.6 || params.build > 1.8) root["build"].Fail("must be in 0.6..1.8");
+  if (root.Has("albedo")) {
+    const JsonNode a = root["albedo"];
+    a.CheckKeys({"skin", "shirt", "pants", "shoes", "hair"});
+    auto read = [&](const char* key, NirReflectance& out) {
+      if (a.Has(key)) out = ReadReflectance(a[key]);
+    };
+    read("skin", params.skin_albedo);
+    read("shirt", params.shirt_albedo);
+    read("pants", params.pants_albedo);
+    read("shoes", params.shoe_albedo);
+    read("hair", params.hair_albedo);
+  }
+  if (params.kind == "tube") {
+    if (root.Has("shape")) root["shape"].Fail("only parametric avatars have a shape");
+    return BuildTubeAvatar(params);
+  }
+  BodyShape shape;
+  if (root.Has("shape")) {
+    const JsonNode s = root["shape"];
+    s.CheckKeys({"shoulder_width", "hip_width", "arm_length", "leg_length", "head_size", "belly", "clothing"});
+    auto ratio = [&](const char* key, double& out, double lo, double hi) {
+      if (!s.Has(key)) return;
+      out = s.GetDouble(key);
+      if (out < lo || out > hi) s[key].Fail("must be in " + std::to_string(lo).substr(0, 4) + ".." + std::to_string(hi).substr(0, 4));
+    };
+    ratio("shoulder_width", shape.shoulder_width, 0.8, 1.25);
+    ratio("hip_width", shape.hip_width, 0.8, 1.3);
+    ratio("arm_length", shape.arm_length, 0.85, 1.15);
+    ratio("leg_length", shape.leg_length, 0.85, 1.15);
+    ratio("head_size", shape.head_size, 0.85, 1.15);
+    ratio("belly", shape.belly, 0.0, 1.0);
+    shape.clothing = s.GetString("clothing", "tight");
+    if (shape.clothing != "tight" && shape.clothing != "loose_shirt" && shape.clothing != "jacket") {
+      s["clothing"].Fail("must be tight, loose_shirt or jacket");
+    }
+  }
+  return BuildParametricAvatar(params, shape);
+}
+
+// Building a parametric avatar's mesh takes about 50 ms (a second under the
+// sanitizers), and suites and sweeps load each avatar several times (to check
+// a scenario, to key its render, to render it): parametric and tube avatars,
+// made from their JSON alone, are kept once built, keyed by the file's name
+// and parsed contents. Mesh avatars read a second file and are not kept.
+class BuiltAvatars {
+ public:
+  static std::optional<Avatar> Find(const std::string& key) {
+    std::lock_guard lock(mutex_);
+    const auto it = built().find(key);
+    if (it == built().end()) return std::nullopt;
+    return it->second;
+  }
+  static void Keep(const std::string& key, const Avatar& avatar) {
+    std::lock_guard lock(mutex_);
+    if (built().size() >= 16) built().clear();
+    built().emplace(key, avatar);
+  }
+
+ private:
+  static std::map<std::string, Avatar>& built() {
+    static std::map<std::string, Avatar> m;
+    return m;
+  }
+  static inline std::mutex mutex_;
+};
+
 }  // namespace
 
 Avatar LoadAvatar(const std::filesystem::path& path) {
@@ -387,50 +465,11 @@ Avatar LoadAvatar(const std::filesystem::path& path) {
     params.style = root["style"].raw();
   }
   if (kind == "mesh") return LoadMeshAvatar(path, root, params.name, params.style);
-  for (const char* key : {"file", "scale", "up_axis", "joint_map"}) {
-    if (root.Has(key)) root[key].Fail("only imported (kind \"mesh\") avatars have it");
-  }
-  params.height_m = root.GetDouble("height_m");
-  if (params.height_m < 1.0 || params.height_m > 2.3) root["height_m"].Fail("must be in 1.0..2.3 m");
-  params.build = root.GetDouble("build", 1.0);
-  if (params.build < 0.6 || params.build > 1.8) root["build"].Fail("must be in 0.6..1.8");
-  if (root.Has("albedo")) {
-    const JsonNode a = root["albedo"];
-    a.CheckKeys({"skin", "shirt", "pants", "shoes", "hair"});
-    auto read = [&](const char* key, NirReflectance& out) {
-      if (a.Has(key)) out = ReadReflectance(a[key]);
-    };
-    read("skin", params.skin_albedo);
-    read("shirt", params.shirt_albedo);
-    read("pants", params.pants_albedo);
-    read("shoes", params.shoe_albedo);
-    read("hair", params.hair_albedo);
-  }
-  if (kind == "tube") {
-    if (root.Has("shape")) root["shape"].Fail("only parametric avatars have a shape");
-    return BuildTubeAvatar(params);
-  }
-  BodyShape shape;
-  if (root.Has("shape")) {
-    const JsonNode s = root["shape"];
-    s.CheckKeys({"shoulder_width", "hip_width", "arm_length", "leg_length", "head_size", "belly", "clothing"});
-    auto ratio = [&](const char* key, double& out, double lo, double hi) {
-      if (!s.Has(key)) return;
-      out = s.GetDouble(key);
-      if (out < lo || out > hi) s[key].Fail("must be in " + std::to_string(lo).substr(0, 4) + ".." + std::to_string(hi).substr(0, 4));
-    };
-    ratio("shoulder_width", shape.shoulder_width, 0.8, 1.25);
-    ratio("hip_width", shape.hip_width, 0.8, 1.3);
-    ratio("arm_length", shape.arm_length, 0.85, 1.15);
-    ratio("leg_length", shape.leg_length, 0.85, 1.15);
-    ratio("head_size", shape.head_size, 0.85, 1.15);
-    ratio("belly", shape.belly, 0.0, 1.0);
-    shape.clothing = s.GetString("clothing", "tight");
-    if (shape.clothing != "tight" && shape.clothing != "loose_shirt" && shape.clothing != "jacket") {
-      s["clothing"].Fail("must be tight, loose_shirt or jacket");
-    }
-  }
-  return BuildParametricAvatar(params, shape);
+  const std::string key = path.stem().string() + '\n' + root.raw().dump();
+  if (std::optional<Avatar> built = BuiltAvatars::Find(key)) return *std::move(built);
+  Avatar avatar = BuildDescribedAvatar(root, params);
+  BuiltAvatars::Keep(key, avatar);
+  return avatar;
 }
 
 void SkinVertices(const Avatar& avatar,

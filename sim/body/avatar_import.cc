@@ -11,9 +11,10 @@
 
 #include "common/error.h"
 #include "common/logging.h"
+#include "common/text.h"
+#include "sim/body/internal/imported_rig.h"
 #include "sim/body/internal/joint_naming.h"
 #include "sim/body/internal/joint_topology.h"
-#include "sim/body/internal/imported_rig.h"
 
 // How an import works (ImportRiggedAvatar):
 //
@@ -810,7 +811,7 @@ Avatar ImportRiggedAvatar(const std::filesystem::path& file, const ImportOptions
   if (!std::filesystem::exists(file, ec)) throw InputError(file.string(), "file", "no such file");
   if (!std::filesystem::is_regular_file(file, ec))
     throw InputError(file.string(), "file", "not a regular file");
-  const std::string ext = import_internal::Lower(file.extension().string());
+  const std::string ext = AsciiLower(file.extension().string());
   const import_internal::Rig rig = ext == ".gltf" || ext == ".glb"
                                        ? import_internal::LoadGltf(file)
                                        : import_internal::LoadAssimp(file);

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
 #include <map>
 
 #include "common/error.h"
@@ -67,6 +70,39 @@ TEST(AvatarTest, BadHeightIsAnInputError) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "height_m");
   }
+}
+
+// LoadAvatar keeps a built parametric avatar: loading again gives the same
+// mesh, and a file rewritten in place (or a copy under another name) is
+// built from what it now says, errors included.
+TEST(AvatarTest, ReloadingFollowsTheFileContents) {
+  const auto dir = std::filesystem::temp_directory_path() / "irbench_avatar_reload";
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, double height) {
+    FILE* f = std::fopen((dir / name).c_str(), "w");
+    std::fprintf(f, R"({"format": "irbench.avatar/1", "kind": "parametric", "height_m": %.2f})", height);
+    std::fclose(f);
+    return dir / name;
+  };
+  const auto span = [](const Avatar& a) {
+    double lo = 1e9, hi = -1e9;
+    for (const MeshVertex& v : a.bind_vertices) lo = std::min<double>(lo, v.position.z()), hi = std::max<double>(hi, v.position.z());
+    return hi - lo;
+  };
+  const Avatar first = LoadAvatar(write("reload.json", 1.60));
+  const Avatar again = LoadAvatar(dir / "reload.json");
+  ASSERT_EQ(again.bind_vertices.size(), first.bind_vertices.size());
+  for (size_t i = 0; i < first.bind_vertices.size(); ++i) {
+    ASSERT_EQ(again.bind_vertices[i].position, first.bind_vertices[i].position) << i;
+  }
+  EXPECT_EQ(again.params.name, "reload");
+  const Avatar taller = LoadAvatar(write("reload.json", 1.90));
+  EXPECT_NEAR(span(taller) - span(first), 0.30, 0.02);
+  const Avatar renamed = LoadAvatar(write("other.json", 1.60));
+  EXPECT_EQ(renamed.params.name, "other");
+  write("reload.json", 2.60);
+  EXPECT_THROW(LoadAvatar(dir / "reload.json"), InputError);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

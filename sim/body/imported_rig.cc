@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/text.h"
 #include "sim/body/internal/joint_naming.h"
 
 namespace irbench::import_internal {
@@ -19,7 +20,7 @@ using Eigen::Vector3d;
 
 // Whether a node, mesh or joint name looks like a prop (weapon, staff, ...).
 bool IsProp(const std::string& name) {
-  const std::string s = Lower(name);
+  const std::string s = AsciiLower(name);
   for (const char* word : {"weapon", "staff", "sword", "shield", "prop", "gun", "tool"}) {
     if (s.find(word) != std::string::npos) return true;
   }

@@ -11,15 +11,10 @@
 #include <utility>
 
 #include "common/error.h"
+#include "common/text.h"
 #include "sim/body/avatar.h"
 
 namespace irbench::import_internal {
-
-// `s` in lower case (ASCII).
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 namespace {
 
@@ -31,7 +26,7 @@ bool StartsWith(const std::string& s, const std::string& prefix) {
 // Lower case, namespace ("mixamorig:", "Character1:") and common prefixes
 // stripped, '.', '-' and ' ' as '_'.
 std::string NormaliseJointName(const std::string& name) {
-  std::string s = Lower(name);
+  std::string s = AsciiLower(name);
   const size_t colon = s.rfind(':');
   if (colon != std::string::npos && colon + 1 < s.size()) s = s.substr(colon + 1);
   for (char& c : s) {
@@ -333,7 +328,7 @@ JointMapping MapJoints(const std::vector<std::string>& rig_names,
     }
     if (found.empty()) {
       for (const std::string& name : rig_names) {
-        if (Lower(name) == Lower(rig) || NormaliseJointName(name) == NormaliseJointName(rig)) {
+        if (AsciiLower(name) == AsciiLower(rig) || NormaliseJointName(name) == NormaliseJointName(rig)) {
           found = name;
           break;
         }

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
 
 namespace irbench {
 namespace {
@@ -30,13 +33,17 @@ Eigen::Vector3f ChannelReflectance(const NirReflectance& r) {
 }
 
 // Light from patch `k` onto a point `p` facing `n` (n unit; cosines clamped).
+// The two faces' signs are checked before the square root (most pairs in a
+// room face away or lie in one wall); the arithmetic is the same either way.
 inline double Transfer(const BouncePatch& k, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
   const Eigen::Vector3d d = k.center - p;  // point -> patch
+  const double toward_p = -k.normal.dot(d), toward_k = n.dot(d);
+  if (toward_p <= 0 || toward_k <= 0) return 0;
   const double r2 = d.squaredNorm();
   if (r2 <= 1e-12) return 0;
   const double r = std::sqrt(r2);
-  const double cos_p = -k.normal.dot(d) / r;
-  const double cos_x = n.dot(d) / r;
+  const double cos_p = toward_p / r;
+  const double cos_x = toward_k / r;
   if (cos_p <= 0 || cos_x <= 0) return 0;
   return k.area * cos_p * cos_x / (M_PI * r2 + k.area);
 }
@@ -93,12 +100,17 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
   }
   for (int bounce = 1; bounce < options.bounces; ++bounce) {
     std::vector<Eigen::Vector3f> next(patches.size());
+    // Only lit patches give light (a dark one would add exact zeros).
+    std::vector<const BouncePatch*> lit;
+    for (const BouncePatch& k : patches) {
+      if (k.radiosity != Eigen::Vector3f::Zero()) lit.push_back(&k);
+    }
     cv::parallel_for_(cv::Range(0, static_cast<int>(patches.size())), [&](const cv::Range& range) {
       for (int j = range.start; j < range.end; ++j) {
         Eigen::Vector3d gathered = Eigen::Vector3d::Zero();
-        for (const BouncePatch& k : patches) {
-          const double f = Transfer(k, patches[j].center, patches[j].normal);
-          if (f > 0) gathered += f * k.radiosity.cast<double>();
+        for (const BouncePatch* k : lit) {
+          const double f = Transfer(*k, patches[j].center, patches[j].normal);
+          if (f > 0) gathered += f * k->radiosity.cast<double>();
         }
         next[j] = ChannelReflectance(patches[j].reflectance).cwiseProduct(direct[j] + gathered.cast<float>());
         next[j][kScreenContent] += patches[j].content;
@@ -109,9 +121,65 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
   return patches;
 }
 
-IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
-                               const std::vector<IrLight>& lights,
-                               const BounceOptions& options) {
+namespace {
+
+// The last volume computed, with what it was computed from: a suite, a sweep
+// or a test renders one scene many times in one process, and the volume
+// costs a second or two each time. Equal inputs (bit for bit: the vertices
+// are tightly packed floats) give the very same volume.
+class LastBounce {
+ public:
+  std::optional<IrradianceVolume> Find(const TriangleMesh& mesh, const std::vector<IrLight>& lights,
+                                       const BounceOptions& options) {
+    std::lock_guard lock(mutex_);
+    if (!volume_ || !Same(mesh, lights, options)) return std::nullopt;
+    return volume_;
+  }
+  void Keep(const TriangleMesh& mesh, const std::vector<IrLight>& lights, const BounceOptions& options,
+            const IrradianceVolume& volume) {
+    std::lock_guard lock(mutex_);
+    mesh_ = mesh;
+    lights_ = lights;
+    options_ = options;
+    volume_ = volume;
+  }
+
+ private:
+  bool Same(const TriangleMesh& mesh, const std::vector<IrLight>& lights, const BounceOptions& options) const {
+    if (mesh.vertices.size() != mesh_.vertices.size() || mesh.indices != mesh_.indices) return false;
+    if (!mesh.vertices.empty() &&
+        std::memcmp(mesh.vertices.data(), mesh_.vertices.data(), mesh.vertices.size() * sizeof(MeshVertex)) != 0) {
+      return false;
+    }
+    if (options.patch_m != options_.patch_m || options.grid_m != options_.grid_m || options.bounces != options_.bounces) {
+      return false;
+    }
+    if (lights.size() != lights_.size()) return false;
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const IrLight &a = lights[i], &b = lights_[i];
+      if (a.position != b.position || a.direction != b.direction || a.cone_deg != b.cone_deg || a.power != b.power ||
+          a.wavelength_nm != b.wavelength_nm) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  std::mutex mutex_;
+  TriangleMesh mesh_;
+  std::vector<IrLight> lights_;
+  BounceOptions options_;
+  std::optional<IrradianceVolume> volume_;
+};
+
+LastBounce& LastBounceVolume() {
+  static LastBounce last;
+  return last;
+}
+
+IrradianceVolume ComputeBounceVolume(const TriangleMesh& mesh,
+                                     const std::vector<IrLight>& lights,
+                                     const BounceOptions& options) {
   IrradianceVolume volume;
   std::vector<BouncePatch> patches = BouncePatches(mesh, lights, options);
   // Patches with no light give none.
@@ -141,10 +209,12 @@ IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
       for (auto& v : e) v.setZero();
       for (const BouncePatch& k : patches) {
         const Eigen::Vector3d d = k.center - p;
+        const double toward_p = -k.normal.dot(d);
+        if (toward_p <= 0) continue;  // p behind the patch (before the root)
         const double r2 = d.squaredNorm();
         if (r2 <= 1e-12) continue;
         const double r = std::sqrt(r2);
-        const double cos_p = -k.normal.dot(d) / r;
+        const double cos_p = toward_p / r;
         if (cos_p <= 0) continue;
         const double w = k.area * cos_p / ((M_PI * r2 + k.area) * r);  // times d·axis
         const Eigen::Vector3d light = w * k.radiosity.cast<double>();
@@ -158,6 +228,18 @@ IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
   });
   return volume;
 }
+
+}  // namespace
+
+IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
+                               const std::vector<IrLight>& lights,
+                               const BounceOptions& options) {
+  if (std::optional<IrradianceVolume> kept = LastBounceVolume().Find(mesh, lights, options)) return *std::move(kept);
+  IrradianceVolume volume = ComputeBounceVolume(mesh, lights, options);
+  LastBounceVolume().Keep(mesh, lights, options, volume);
+  return volume;
+}
+
 
 Eigen::Vector3f IrradianceVolume::Irradiance(const Eigen::Vector3d& p, const Eigen::Vector3d& normal) const {
   if (empty()) return Eigen::Vector3f::Zero();

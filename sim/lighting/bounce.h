@@ -64,6 +64,9 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
                                        const std::vector<IrLight>& lights,
                                        const BounceOptions& options);
 
+// The bounce light's irradiance volume. The last one computed is kept (a
+// suite or sweep renders one scene many times in one process): the same
+// inputs, bit for bit, return it again.
 IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
                                const std::vector<IrLight>& lights,
                                const BounceOptions& options = {});

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace irbench {
@@ -105,6 +106,37 @@ TEST(BounceTest, SecondBounceGathersFromTheFacingPlate) {
   for (const BouncePatch& p : BouncePatches(mesh, {}, options)) {
     if (p.center.z() > 0.5) EXPECT_EQ(p.radiosity[kScreenContent], 0.0f);
   }
+}
+
+// The volume kept from the last call is only returned for the same inputs:
+// a light twice as strong doubles the volume, the first light again gives the
+// first volume exactly, and a changed reflectance changes it.
+TEST(BounceTest, TheKeptVolumeFollowsItsInputs) {
+  TriangleMesh mesh;
+  AppendQuad(mesh, {-1.5, -1.5, 0}, {3, 0, 0}, {0, 3, 0}, Material{0.5f, 0.0f});
+  AppendQuad(mesh, {-1.5, -1.5, 2}, {0, 3, 0}, {3, 0, 0}, Material{0.5f, 0.0f});
+  IrLight light;
+  light.position = {0, 0, 1.5};
+  light.direction = -Eigen::Vector3d::UnitZ();
+  light.cone_deg = 120;
+  const IrradianceVolume first = ComputeBounce(mesh, {light});
+  ASSERT_FALSE(first.empty());
+  IrLight brighter = light;
+  brighter.power = 2 * light.power;
+  const IrradianceVolume doubled = ComputeBounce(mesh, {brighter});
+  ASSERT_EQ(doubled.values.size(), first.values.size());
+  double largest = 0;
+  for (size_t i = 0; i < first.values.size(); ++i) {
+    EXPECT_LT((doubled.values[i] - 2 * first.values[i]).norm(), 1e-5 * (1 + first.values[i].norm())) << i;
+    largest = std::max<double>(largest, first.values[i].norm());
+  }
+  EXPECT_GT(largest, 0);
+  const IrradianceVolume again = ComputeBounce(mesh, {light});
+  EXPECT_EQ(again.values, first.values);
+  TriangleMesh darker = mesh;
+  for (MeshVertex& v : darker.vertices) v.albedo = 0.25f;
+  const IrradianceVolume dim = ComputeBounce(darker, {light});
+  EXPECT_NE(dim.values, first.values);
 }
 
 }  // namespace

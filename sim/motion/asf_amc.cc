@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/text.h"
 
 // Conventions, checked against:
 // - CMU mocapPlayer (the "amc viewer", http://mocap.cs.cmu.edu/tools.php):
@@ -58,11 +59,6 @@ bool IsTranslation(Dof d) {
 }
 int AxisOf(Dof d) {
   return static_cast<int>(d) % 3;
-}
-
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 // Rotation by `radians` about world axis 0 (x), 1 (y) or 2 (z).
@@ -294,7 +290,7 @@ class AsfParser : public LineReader {
       skeleton_.length_unit = length;
     } else if (key == "angle") {
       ExpectValues(line, 1);
-      const std::string unit = Lower(line.tokens[1]);
+      const std::string unit = AsciiLower(line.tokens[1]);
       if (unit == "deg" || unit == "degrees") {
         to_radians_ = std::numbers::pi / 180.0;
       } else if (unit == "rad" || unit == "radians") {
@@ -501,7 +497,7 @@ class AsfParser : public LineReader {
     static const std::pair<const char*, Dof> kNames[] = {
         {"tx", Dof::kTx}, {"ty", Dof::kTy}, {"tz", Dof::kTz}, {"rx", Dof::kRx},
         {"ry", Dof::kRy}, {"rz", Dof::kRz}, {"l", Dof::kL}};
-    const std::string lower = Lower(token);
+    const std::string lower = AsciiLower(token);
     for (const auto& [name, dof] : kNames) {
       if (lower == name) return dof;
     }

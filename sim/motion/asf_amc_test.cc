@@ -12,9 +12,11 @@
 #include <string>
 
 #include "common/error.h"
+#include "sim/motion/motion_test_util.h"
 
 namespace irbench {
 namespace {
+using irbench::testing::Replace;
 
 using Eigen::AngleAxisd;
 using Eigen::Matrix3d;
@@ -96,13 +98,6 @@ int LineOf(const std::string& text, const std::string& needle) {
   const size_t at = text.find(needle);
   EXPECT_NE(at, std::string::npos) << needle;
   return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
-}
-
-std::string Replace(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
 }
 
 std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {

@@ -12,11 +12,14 @@
 #include "common/error.h"
 #include "sim/body/avatar.h"
 #include "sim/motion/library.h"
+#include "sim/motion/motion_test_util.h"
 #include "sim/motion/retarget.h"
 #include "tests/test_util.h"
 
 namespace irbench {
 namespace {
+using irbench::testing::Person;
+using irbench::testing::Replace;
 namespace fs = std::filesystem;
 
 const char* kSmallBvh =
@@ -40,12 +43,6 @@ const char* kSmallBvh =
     "Frame Time:\t0.0083333\n"
     "1 2 3 0 0 0 90 0 0\n"
     "1 2 3 90 0 0 0 0 0\n";
-
-std::string Replace(std::string s, const std::string& from, const std::string& to) {
-  const size_t at = s.find(from);
-  if (at != std::string::npos) s.replace(at, from.size(), to);
-  return s;
-}
 
 // Line of an InputError's field "line N".
 int LineOf(const std::string& text) {
@@ -199,10 +196,6 @@ TEST(BvhTest, AbsurdValuesAreRefused) {
 TEST(BvhTest, HugeFrameCountIsAnErrorWithoutAllocating) {
   const InputError e = ErrorOf(Replace(kSmallBvh, "Frames:\t2", "Frames:\t99999999"));
   EXPECT_EQ(e.field(), "line 20") << e.what();
-}
-
-Avatar Person(const std::string& name) {
-  return LoadAvatar(fs::path(IRBENCH_SOURCE_DIR) / "avatars" / (name + ".json"));
 }
 
 TEST(BvhTest, ExportReimportRoundTrip) {

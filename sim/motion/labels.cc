@@ -5,12 +5,12 @@
 namespace irbench {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kRadiansPerDegree = M_PI / 180.0;
 constexpr double kVelocityStep = 0.05;  // s, central difference half-step
 constexpr double kStraightElbowDeg = 25;
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) / kDeg;
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) / kRadiansPerDegree;
 }
 
 nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
@@ -41,7 +41,7 @@ std::string MotionLabel(bool rest, const Eigen::Vector3d& v) {
 
 std::string ArmAtom(bool rest, const Eigen::Vector3d& shoulder_to_tip) {
   if (rest) return "A0";
-  const double el = std::asin(std::clamp(shoulder_to_tip.normalized().z(), -1.0, 1.0)) / kDeg;
+  const double el = std::asin(std::clamp(shoulder_to_tip.normalized().z(), -1.0, 1.0)) / kRadiansPerDegree;
   if (el >= 62.5) return "A2";
   if (el >= 22.5) return "A3";
   if (el >= -22.5) return "A1";

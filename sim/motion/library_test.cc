@@ -9,15 +9,13 @@
 
 #include "common/error.h"
 #include "sim/motion/labels.h"
+#include "sim/motion/motion_test_util.h"
 #include "sim/motion/session.h"
 
 namespace irbench {
 namespace {
+using irbench::testing::Person;
 namespace fs = std::filesystem;
-
-Avatar Person(const std::string& name) {
-  return LoadAvatar(fs::path(IRBENCH_SOURCE_DIR) / "avatars" / (name + ".json"));
-}
 
 const Scene& Theater() {
   static const Scene scene = LoadScene(fs::path(IRBENCH_SOURCE_DIR) / "scenes" / "theater.json");

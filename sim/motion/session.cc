@@ -5,6 +5,7 @@
 #include "common/error.h"
 #include "common/json_reader.h"
 #include "common/paths.h"
+#include "common/text.h"
 #include "sim/motion/keyframes.h"
 #include "sim/motion/retarget.h"
 
@@ -12,11 +13,6 @@ namespace irbench {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), ::tolower);
-  return s;
-}
 
 bool IsLibraryName(const std::string& name) {
   for (const auto& [n, text] : LibraryMotions()) {
@@ -119,7 +115,7 @@ MotionPtr LoadSession(const fs::path& path, MotionContext& ctx) {
 ResolvedMotion ResolveMotion(const std::string& spec, MotionContext& ctx, const std::string& option) {
   if (spec.empty()) throw InputError("", option, "empty motion");
   const fs::path as_path(spec);
-  const std::string ext = Lower(as_path.extension().string());
+  const std::string ext = AsciiLower(as_path.extension().string());
   if (ext == ".bvh" || ext == ".amc") {
     if (!fs::is_regular_file(as_path)) throw InputError(spec, option, "no such file");
     return {LoadClip(as_path, ctx, 0, 0), ext.substr(1), as_path};

@@ -8,6 +8,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
 #include "common/logging.h"
 #include "sequence_format/calibration.h"
 #include "sim/sequence/render_resume.h"  // FrameFileName
@@ -67,11 +68,6 @@ void LinkTree(const fs::path& from, const fs::path& to) {
   }
 }
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 void WriteImage(const fs::path& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", image, bytes)) throw RuntimeError("cannot encode " + path.string());
@@ -106,7 +102,7 @@ int ApplyFault(const CameraFault& fault, const fs::path& root, double fps, int f
         break;
       case CameraFaultKind::kDrop: fs::remove(path); break;
       case CameraFaultKind::kCorrupt: {
-        const std::string bytes = ReadBytes(path);
+        const std::string bytes = ReadFileBytes(path);
         AtomicWriteFile(path, std::string_view(bytes).substr(0, std::min<size_t>(bytes.size(), 64)));
         break;
       }

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/file_bytes.h"
 #include "common/logging.h"
 
 namespace irbench {
@@ -15,18 +16,11 @@ namespace {
 
 constexpr char kJournalDir[] = ".render-journal";
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 // The complete lines of a journal file whose "frame" counts 0, 1, ...: a
 // line cut short by the kill, or anything after it, is dropped.
 std::vector<std::string> JournalLines(const fs::path& path, int max_lines) {
   std::vector<std::string> lines;
-  const std::string text = ReadBytes(path);
+  const std::string text = ReadFileBytes(path);
   size_t from = 0;
   for (size_t end; (end = text.find('\n', from)) != std::string::npos && int(lines.size()) < max_lines;
        from = end + 1) {
@@ -99,7 +93,7 @@ std::string FrameFileName(int frame, const char* ext) {
 std::string RenderOptionsHash(const nlohmann::json& manifest, const std::vector<fs::path>& input_files) {
   std::string key = manifest.dump();
   for (const fs::path& file : input_files) {
-    if (!file.empty() && fs::is_regular_file(file)) key += "|" + ReadBytes(file);
+    if (!file.empty() && fs::is_regular_file(file)) key += "|" + ReadFileBytes(file);
   }
   char hex[20];
   std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(Fnv1a64(key)));
@@ -111,7 +105,7 @@ RenderJournal StartRenderJournal(StagingDir& staging, const std::string& hash, c
   const fs::path options_file = root / kJournalDir / "options.json";
   RenderJournal kept;
   if (staging.adopted()) {
-    const nlohmann::json made = nlohmann::json::parse(ReadBytes(options_file), nullptr, false);
+    const nlohmann::json made = nlohmann::json::parse(ReadFileBytes(options_file), nullptr, false);
     if (!made.is_discarded() && made.is_object() && made.value("hash", "") == hash) {
       RemoveTemporaries(root);
       kept = KeptJournal(root, layout);
@@ -161,7 +155,7 @@ int ReplayStart(const std::vector<std::string>& lines, const std::vector<std::st
 void WriteOrVerify(const fs::path& path, const std::string& bytes, bool verify) {
   if (!verify) {
     AtomicWriteFile(path, bytes);
-  } else if (ReadBytes(path) != bytes) {
+  } else if (ReadFileBytes(path) != bytes) {
     throw ResumeMismatch(path.string() + " differs when rendered again");
   }
 }

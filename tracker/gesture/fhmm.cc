@@ -6,13 +6,6 @@
 #include <string>
 
 namespace irbench {
-namespace {
-
-// Uniform in [0, 1) from the generator's raw bits (the standard's
-// distributions differ between libraries; this does not).
-double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-}  // namespace
 
 int Fhmm::product_size() const {
   int n = 1;
@@ -140,10 +133,10 @@ Fhmm InitialFhmm(const std::vector<Eigen::MatrixXd>& sequences, int chain_count,
     model.chains.push_back(StickyChain(states_per_chain, stay));
     Eigen::MatrixXd w(d, states_per_chain);
     for (int k = 0; k < states_per_chain; ++k) {
-      const auto* s = nonempty[static_cast<size_t>(Uniform(rng) * nonempty.size())];
-      const int t = static_cast<int>(Uniform(rng) * s->cols());
+      const auto* s = nonempty[static_cast<size_t>(UniformDraw(rng) * nonempty.size())];
+      const int t = static_cast<int>(UniformDraw(rng) * s->cols());
       w.col(k) = s->col(t) / chain_count;
-      for (int i = 0; i < d; ++i) w(i, k) += 0.1 * std::sqrt(scale) * (Uniform(rng) - 0.5);
+      for (int i = 0; i < d; ++i) w(i, k) += 0.1 * std::sqrt(scale) * (UniformDraw(rng) - 0.5);
     }
     model.weights.push_back(w);
   }

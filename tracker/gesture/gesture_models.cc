@@ -15,9 +15,7 @@
 namespace irbench {
 namespace {
 
-constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 
-double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 Eigen::MatrixXd Observations(const std::vector<GestureObservation>& segment, int dimension) {
   Eigen::MatrixXd y(dimension, segment.size());
@@ -92,7 +90,7 @@ Fhmm TrainOneFhmm(const std::vector<Eigen::MatrixXd>& data, const GestureTrainin
   bw.max_iterations = o.max_iterations;
   CovarianceOptions cov{o.covariance_ridge};
   Fhmm best;
-  double best_ll = kNegInf;
+  double best_ll = kLogZero;
   for (int r = 0; r < o.restarts; ++r) {
     Fhmm m = InitialFhmm(data, 2, o.chain_states, 0.8, seed + 7919 * r);
     m.covariance.diagonal().array() += o.covariance_ridge;
@@ -123,16 +121,16 @@ GaussianHmm TrainOneHmm(const std::vector<Eigen::MatrixXd>& data, const GestureT
   BaumWelchOptions bw;
   bw.max_iterations = o.max_iterations;
   GaussianHmm best;
-  double best_ll = kNegInf;
+  double best_ll = kLogZero;
   std::mt19937_64 rng(seed);
   for (int r = 0; r < o.restarts; ++r) {
     GaussianHmm m;
     m.chain = StickyChain(o.hmm_states, 0.8);
     m.means.resize(d, o.hmm_states);
     for (int k = 0; k < o.hmm_states; ++k) {
-      const auto& y = data[static_cast<size_t>(Uniform(rng) * data.size())];
-      m.means.col(k) = y.col(static_cast<int>(Uniform(rng) * y.cols()));
-      for (int i = 0; i < d; ++i) m.means(i, k) += 0.05 * std::sqrt(cov(i, i)) * (Uniform(rng) - 0.5);
+      const auto& y = data[static_cast<size_t>(UniformDraw(rng) * data.size())];
+      m.means.col(k) = y.col(static_cast<int>(UniformDraw(rng) * y.cols()));
+      for (int i = 0; i < d; ++i) m.means(i, k) += 0.05 * std::sqrt(cov(i, i)) * (UniformDraw(rng) - 0.5);
     }
     m.covariance = cov;
     try {
@@ -151,7 +149,7 @@ DiscreteHmm TrainOneChain(const std::vector<std::vector<int>>& data, const Gestu
   DiscreteHmm m;
   m.chain = StickyChain(k, 0.8);
   // The thesis: a gesture starts at rest (pi_0 = 1).
-  m.chain.log_initial = Eigen::VectorXd::Constant(k, kNegInf);
+  m.chain.log_initial = Eigen::VectorXd::Constant(k, kLogZero);
   m.chain.log_initial(0) = 0;
   Eigen::MatrixXd b = Eigen::MatrixXd::Constant(k, k, 0.4 / (k - 1));
   b.diagonal().setConstant(0.6);
@@ -190,7 +188,7 @@ double GestureModels::LogLikelihood(GestureModelKind kind, int g, const std::vec
       return pahmm.at(g)[0].LogLikelihood(Symbols(segment, true, dimension())) +
              pahmm.at(g)[1].LogLikelihood(Symbols(segment, false, dimension()));
   }
-  return kNegInf;
+  return kLogZero;
 }
 
 int GestureModels::Classify(GestureModelKind kind, const std::vector<GestureObservation>& segment,
@@ -309,7 +307,7 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
           p[c]["emission"][i].Fail("must be probabilities summing to 1");
         }
       }
-      pa[c].log_emission = b.unaryExpr([](double v) { return v > 0 ? std::log(v) : kNegInf; });
+      pa[c].log_emission = b.unaryExpr([](double v) { return v > 0 ? std::log(v) : kLogZero; });
     }
     m.pahmm.push_back(pa);
     const JsonNode f = e["fhmm"];

@@ -10,9 +10,8 @@
 namespace irbench {
 namespace {
 
-constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 
-double SafeLog(double p) { return p > 0 ? std::log(p) : kNegInf; }
+double SafeLog(double p) { return p > 0 ? std::log(p) : kLogZero; }
 
 void CheckEmission(const LogMarkovChain& chain, const Eigen::MatrixXd& log_emission) {
   if (log_emission.cols() != chain.size()) {
@@ -36,9 +35,9 @@ double EStep(const LogMarkovChain& chain, size_t count, Emit emit, std::vector<P
 }  // namespace
 
 double LogSumExp(const Eigen::Ref<const Eigen::VectorXd>& v) {
-  if (v.size() == 0) return kNegInf;
+  if (v.size() == 0) return kLogZero;
   const double m = v.maxCoeff();
-  if (m == kNegInf) return kNegInf;
+  if (m == kLogZero) return kLogZero;
   if (m == std::numeric_limits<double>::infinity()) return m;
   return m + std::log((v.array() - m).exp().sum());
 }
@@ -112,11 +111,11 @@ Posteriors ForwardBackward(const LogMarkovChain& chain, const Eigen::MatrixXd& l
   p.xi_sum = Eigen::MatrixXd::Zero(n, n);
   for (int t = 0; t + 1 < t_count; ++t) {
     for (int i = 0; i < n; ++i) {
-      if (p.log_alpha(t, i) == kNegInf) continue;
+      if (p.log_alpha(t, i) == kLogZero) continue;
       for (int j = 0; j < n; ++j) {
         const double l = p.log_alpha(t, i) + chain.log_transition(i, j) + log_emission(t + 1, j) +
                          p.log_beta(t + 1, j) - p.log_likelihood;
-        if (l != kNegInf) p.xi_sum(i, j) += std::exp(l);
+        if (l != kLogZero) p.xi_sum(i, j) += std::exp(l);
       }
     }
   }

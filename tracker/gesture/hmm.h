@@ -11,9 +11,19 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <random>
 #include <vector>
 
 namespace irbench {
+
+// log(0): a probability of 0 in log space.
+inline constexpr double kLogZero = -std::numeric_limits<double>::infinity();
+
+// Uniform in [0, 1) from the generator's raw bits (the standard's
+// distributions differ between libraries; this does not): the models'
+// seeded random starts.
+inline double UniformDraw(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 // log(sum(exp(v))), -inf for an empty vector or one that is all -inf.
 double LogSumExp(const Eigen::Ref<const Eigen::VectorXd>& v);

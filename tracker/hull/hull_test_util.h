@@ -13,6 +13,10 @@
 
 namespace irbench::testing {
 
+// The sphere the hull tests carve from its silhouettes.
+inline const Eigen::Vector3d kSphereCentre(0.2, -0.1, 1.0);
+inline constexpr double kSphereRadius = 0.3;
+
 // `ring` cameras on a circle of radius `radius_m` at height `height_m` and
 // `high` more on a smaller circle above, all looking at `target`; 320 x 240,
 // mild barrel distortion so the tests exercise the lens model.

@@ -12,8 +12,8 @@ using irbench::testing::BoxSilhouette;
 using irbench::testing::HullRig;
 using irbench::testing::SphereSilhouette;
 
-const Eigen::Vector3d kCentre(0.2, -0.1, 1.0);
-constexpr double kRadius = 0.3;
+using irbench::testing::kSphereCentre;
+using irbench::testing::kSphereRadius;
 
 // Distance from a pixel to the nearest polygon edge.
 double DistanceToBoundary(const SilhouettePolygons& poly, const Eigen::Vector2d& px) {
@@ -38,7 +38,7 @@ Scene SphereScene(int ring, int high) {
   Scene s;
   s.cams = HullRig(ring, high);
   for (const Camera& cam : s.cams) {
-    s.masks.push_back(SphereSilhouette(cam, kCentre, kRadius));
+    s.masks.push_back(SphereSilhouette(cam, kSphereCentre, kSphereRadius));
     s.polys.push_back(ApproximateSilhouette(s.masks.back()));
   }
   return s;
@@ -64,10 +64,10 @@ TEST(PolyhedralHullTest, SphereHullLiesOnOrOutsideTheSphereAndInsideTheVoxelHull
   for (const auto& t : mesh->triangles) used.insert(used.end(), t.begin(), t.end());
   for (size_t i : used) {
     const Eigen::Vector3d& p = mesh->vertices[i];
-    nearest = std::min(nearest, (p - kCentre).norm());
+    nearest = std::min(nearest, (p - kSphereCentre).norm());
     outside_voxels += !voxels.ContainsPoint(p);
   }
-  EXPECT_GE(nearest, kRadius - tolerance_m);
+  EXPECT_GE(nearest, kSphereRadius - tolerance_m);
   EXPECT_EQ(outside_voxels, 0) << "of " << used.size();
   // Every vertex projects into every view's polygon (or onto its edge): it
   // lies on the cones' intersection.
@@ -79,7 +79,7 @@ TEST(PolyhedralHullTest, SphereHullLiesOnOrOutsideTheSphereAndInsideTheVoxelHull
     }
   }
   EXPECT_EQ(off_polygon, 0);
-  const double sphere = 4.0 / 3.0 * M_PI * std::pow(kRadius, 3);
+  const double sphere = 4.0 / 3.0 * M_PI * std::pow(kSphereRadius, 3);
   const double volume = MeshVolume(*mesh);
   std::printf("polyhedral sphere hull, 8 cameras: %zu triangles, volume ratio %.3f (voxel %.3f)\n",
               mesh->triangles.size(), volume / sphere, voxels.VolumeM3() / sphere);

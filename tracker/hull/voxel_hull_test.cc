@@ -17,8 +17,8 @@ using irbench::testing::BoxSilhouette;
 using irbench::testing::HullRig;
 using irbench::testing::SphereSilhouette;
 
-const Eigen::Vector3d kCentre(0.2, -0.1, 1.0);
-constexpr double kRadius = 0.3;
+using irbench::testing::kSphereCentre;
+using irbench::testing::kSphereRadius;
 
 // Points of the solid, sampled on a jittered grid at voxel spacing, that do not
 // lie in an occupied voxel; `checked` counts the samples.
@@ -57,14 +57,14 @@ VoxelGridOptions Strict() {
 
 std::vector<cv::Mat> Spheres(const std::vector<Camera>& cams) {
   std::vector<cv::Mat> out;
-  for (const Camera& cam : cams) out.push_back(SphereSilhouette(cam, kCentre, kRadius));
+  for (const Camera& cam : cams) out.push_back(SphereSilhouette(cam, kSphereCentre, kSphereRadius));
   return out;
 }
 
 TEST(VoxelHullTest, ContainsTheSphereWithBoundedVolume) {
-  auto in_sphere = [](const Eigen::Vector3d& p) { return (p - kCentre).norm() < kRadius; };
-  const Eigen::Vector3d lo = kCentre.array() - kRadius, hi = kCentre.array() + kRadius;
-  const double sphere = 4.0 / 3.0 * M_PI * std::pow(kRadius, 3);
+  auto in_sphere = [](const Eigen::Vector3d& p) { return (p - kSphereCentre).norm() < kSphereRadius; };
+  const Eigen::Vector3d lo = kSphereCentre.array() - kSphereRadius, hi = kSphereCentre.array() + kSphereRadius;
+  const double sphere = 4.0 / 3.0 * M_PI * std::pow(kSphereRadius, 3);
   for (int ring : {4, 6}) {
     const std::vector<Camera> cams = HullRig(ring, 2);
     const VoxelHull hull = VoxelCarver(cams, Strict()).Carve(Spheres(cams));
@@ -80,7 +80,7 @@ TEST(VoxelHullTest, ContainsTheSphereWithBoundedVolume) {
     EXPECT_LT(ratio, 1.15 * 1.33);
     // No occupied voxel is far from the sphere (the cones meet near it).
     for (const Eigen::Vector3d& c : hull.OccupiedCenters())
-      EXPECT_LT((c - kCentre).norm(), kRadius + 0.1);
+      EXPECT_LT((c - kSphereCentre).norm(), kSphereRadius + 0.1);
     // The default (margin 0) loses at most a sliver at the outline.
     const VoxelHull tight = VoxelCarver(cams).Carve(Spheres(cams));
     const int missed = Missed(tight, lo, hi, in_sphere);
@@ -117,8 +117,8 @@ TEST(VoxelHullTest, OneMissingViewIsToleratedWhenAsked) {
   for (size_t i = 0; i < kept.occupied.size(); ++i) differ += kept.occupied[i] != reference.occupied[i];
   EXPECT_LE(differ, reference.occupied_count / 100);
   EXPECT_GT(reference.occupied_count, 300);
-  auto in_sphere = [](const Eigen::Vector3d& p) { return (p - kCentre).norm() < kRadius; };
-  EXPECT_EQ(Missed(kept, kCentre.array() - kRadius, kCentre.array() + kRadius, in_sphere), 0);
+  auto in_sphere = [](const Eigen::Vector3d& p) { return (p - kSphereCentre).norm() < kSphereRadius; };
+  EXPECT_EQ(Missed(kept, kSphereCentre.array() - kSphereRadius, kSphereCentre.array() + kSphereRadius, in_sphere), 0);
   tolerant.max_missing_views = -1;
   EXPECT_THROW(tolerant.Check(), InputError);
 }
@@ -169,7 +169,7 @@ TEST(VoxelHullTest, MatchesABruteForceCarving) {
     for (int y = 0; y < hull.ny; ++y) {
       for (int x = 0; x < hull.nx; ++x) {
         const Eigen::Vector3d centre = hull.VoxelCenter(x, y, z);
-        if ((centre - kCentre).norm() > 0.6) {
+        if ((centre - kSphereCentre).norm() > 0.6) {
           EXPECT_FALSE(hull.Occupied(x, y, z));  // every camera sees it, far off the sphere
           continue;
         }

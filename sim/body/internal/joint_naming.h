@@ -11,9 +11,6 @@
 
 namespace irbench::import_internal {
 
-// `s` in lower case (ASCII).
-std::string Lower(std::string s);
-
 // The first `limit` names joined with ", ", then the total when there are more.
 std::string JoinNames(const std::vector<std::string>& names, size_t limit = 60);
 
