@@ -119,7 +119,13 @@ fs::path* LiveTest::seq_ = nullptr;
 
 TEST_F(LiveTest, EveryTrackedFrameSetIsOneBundleWithTheRecordedJoints) {
   Receiver receiver;
-  const LiveReport report = RunLiveJob(Options(receiver.port(), "live.jsonl"));
+  // Frame-sets arrive at 10/s, well under what the tracker keeps up with on a
+  // loaded 2-core machine (about 20/s), so that nearly every one is tracked
+  // and the accuracy below does not depend on the machine's load; dropping
+  // is the next test's.
+  LiveJobOptions options = Options(receiver.port(), "live.jsonl");
+  options.fps = 10;
+  const LiveReport report = RunLiveJob(options);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last datagrams
   std::printf("live: %d arrived, %d tracked, %d dropped; latency median %.1f ms, p99 %.1f ms, max %.1f ms\n",
               report.arrived, report.tracked, report.dropped, report.latency_median_ms, report.latency_p99_ms,
@@ -177,6 +183,8 @@ TEST_F(LiveTest, EveryTrackedFrameSetIsOneBundleWithTheRecordedJoints) {
   }
   // What was tracked tracks the person: the recorded track against the truth.
   const irbench::testing::TrackFigures figures = irbench::testing::UpperBodyFigures(record, truth);
+  std::printf("live: tracked %.0f %% of the truth's frames, upper-body mean error %.2f cm\n", 100 * figures.Fraction(),
+              figures.mean_error_cm);
   EXPECT_GT(figures.Fraction(), 0.8);
   EXPECT_LT(figures.mean_error_cm, 6.0);
 }
