@@ -48,6 +48,9 @@ inline double Transfer(const BouncePatch& k, const Eigen::Vector3d& p, const Eig
   return k.area * cos_p * cos_x / (M_PI * r2 + k.area);
 }
 
+// Whether a patch gives any light (radiosities are never negative).
+bool GivesLight(const BouncePatch& p) { return p.radiosity.maxCoeff() > 0; }
+
 }  // namespace
 
 std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
@@ -100,10 +103,10 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
   }
   for (int bounce = 1; bounce < options.bounces; ++bounce) {
     std::vector<Eigen::Vector3f> next(patches.size());
-    // Only lit patches give light (a dark one would add exact zeros).
+    // Only lit patches are gathered from (a dark one would add exact zeros).
     std::vector<const BouncePatch*> lit;
     for (const BouncePatch& k : patches) {
-      if (k.radiosity != Eigen::Vector3f::Zero()) lit.push_back(&k);
+      if (GivesLight(k)) lit.push_back(&k);
     }
     cv::parallel_for_(cv::Range(0, static_cast<int>(patches.size())), [&](const cv::Range& range) {
       for (int j = range.start; j < range.end; ++j) {
@@ -184,7 +187,7 @@ IrradianceVolume ComputeBounceVolume(const TriangleMesh& mesh,
   std::vector<BouncePatch> patches = BouncePatches(mesh, lights, options);
   // Patches with no light give none.
   patches.erase(std::remove_if(patches.begin(), patches.end(),
-                               [](const BouncePatch& p) { return p.radiosity.maxCoeff() <= 0; }),
+                               [](const BouncePatch& p) { return !GivesLight(p); }),
                 patches.end());
   if (patches.empty() || mesh.vertices.empty()) return volume;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
