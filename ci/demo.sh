@@ -6,6 +6,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./ci/install_deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+./ci/configure.sh build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 ./build/irbench demo --force "$@"

@@ -26,20 +26,10 @@ ALL_FUZZERS=(bvh asf_amc gltf rig scene suite calibration)
 read -r -a FUZZERS <<<"${FUZZ_TARGETS:-${ALL_FUZZERS[*]}}"
 start=$SECONDS
 
-# Unit tests left out under the sanitizers (a ctest -E regular expression),
-# for time only: each runs in the main build's ctest (ci/test.sh). Measured on
-# 2 cores, clang 14, ASan + UBSan:
-#  - VoxelHullTest: CoarseToFineEqualsThePerVoxelReference 206 s,
-#    ContainsTheSphereWithBoundedVolume 132 s, CamerasThatDoNotSeeAVoxelDoNotCarveIt
-#    71 s (dense voxel grids checked voxel by voxel); PolyhedralHullTest's
-#    SphereHullLiesOnOrOutsideTheSphereAndInsideTheVoxelHull 82 s (the same
-#    dense carve as its reference; the polyhedral hull's other tests run).
-#  - ScoreTest.*, ReportTest.* (8 tests, 52-66 s each): every test process
-#    renders and tracks the same sequence in its suite set-up (about 50 s
-#    under ASan), 7.5 min of CPU for checks that run in a second.
-EXCLUDE_UNIT_TESTS="^(VoxelHullTest[.](CoarseToFineEqualsThePerVoxelReference|ContainsTheSphereWithBoundedVolume"
-EXCLUDE_UNIT_TESTS+="|CamerasThatDoNotSeeAVoxelDoNotCarveIt)|PolyhedralHullTest[.]SphereHullLiesOnOrOutsideTheSphereAndInsideTheVoxelHull"
-EXCLUDE_UNIT_TESTS+="|ScoreTest[.]|ReportTest[.])"
+# The unit tests that take minutes under ASan (dense voxel grids checked voxel
+# by voxel; a render and a track in each test process's set-up) are declared
+# SLOW_UNDER_SANITIZERS beside their library: this build leaves them out, and
+# ci/test.sh's Release build runs them.
 
 # Mesa's software DRI driver, which EGL (surfaceless) loads and unloads again in
 # eglTerminate: preloaded, it stays mapped, so LeakSanitizer neither reports
@@ -66,7 +56,7 @@ configure_and_build() {
   # -Wno-unknown-warning-option: the project's GCC-only -Wno-restrict.
   # -gline-tables-only: the reports' stacks keep their files and lines, and
   # the build takes about a third less time than with full debug information.
-  locked cmake -S . -B "$BUILD_DIR" \
+  locked ./ci/configure.sh "$BUILD_DIR" \
     -DCMAKE_C_COMPILER="${SANITIZE_CC:-clang}" -DCMAKE_CXX_COMPILER="${SANITIZE_CXX:-clang++}" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
@@ -88,7 +78,6 @@ export LSAN_OPTIONS="suppressions=$ROOT/ci/lsan.supp:print_suppressions=0"
 run_unit_tests() {
   step "unit tests and the fuzz regressions (ctest -L 'unit|fuzz')"
   local args=(--test-dir "$BUILD_DIR" -L 'unit|fuzz' --output-on-failure -j"$JOBS" --timeout 300)
-  if [ -n "$EXCLUDE_UNIT_TESTS" ]; then args+=(-E "$EXCLUDE_UNIT_TESTS"); fi
   if [ -f "$MESA_DRI_DRIVER" ]; then
     LD_PRELOAD="$MESA_DRI_DRIVER${LD_PRELOAD:+:$LD_PRELOAD}" ctest "${args[@]}"
   else

@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# Installs what is missing (Debian 12), builds, and runs every test; then the
-# unit tests and fuzzers under the sanitizers (ci/sanitize.sh).
+# Installs what is missing (Debian 12), builds, and runs every test: the
+# closed-loop tests (and the unit tests too slow under the sanitizers) from a
+# Release build, then the unit tests and fuzzers under the sanitizers
+# (ci/sanitize.sh). IRBENCH_UNIT_TESTS=ON runs every unit test in the Release
+# build as well.
 # The README's second command and what CI runs (.ci/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./ci/install_deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+./ci/configure.sh build -DCMAKE_BUILD_TYPE=Release -DIRBENCH_UNIT_TESTS="${IRBENCH_UNIT_TESTS:-OFF}"
 cmake --build build -j"$(nproc)"
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 # The unit tests under ASan + UBSan (clang, build-san/) and a short run of every

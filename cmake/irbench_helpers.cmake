@@ -1,15 +1,20 @@
 # irbench_test(NAME SOURCES... LIBS ... [LABELS label] [COST seconds]
-#              [SHARED_RENDERS]): a GoogleTest binary registered with CTest. Its
-# tests carry the CTest label "closed_loop" when it is declared under tests/
-# (renders, the CLI, the tracker end to end) and "unit" beside a library;
-# `ctest -L unit` runs the latter (ci/sanitize.sh). LABELS replaces that label
-# (one label: gtest_discover_tests splits lists). COST: about how long its
-# longest test runs; `ctest -j` starts the costliest first, so a fresh build
-# directory (no CTestCostData.txt yet) does not end on a long test alone.
+#              [SHARED_RENDERS] [SLOW_UNDER_SANITIZERS filter]): a GoogleTest
+# binary registered with CTest. Its tests carry the CTest label "closed_loop"
+# when it is declared under tests/ (renders, the CLI, the tracker end to end)
+# and "unit" beside a library; `ctest -L unit` runs the latter
+# (ci/sanitize.sh). LABELS replaces that label (one label:
+# gtest_discover_tests splits lists). COST: about how long its longest test
+# runs; `ctest -j` starts the costliest first, so a fresh build directory (no
+# CTestCostData.txt yet) does not end on a long test alone.
 # SHARED_RENDERS: its tests use tests/shared_render.h, whose renders CTest
 # clears before the first and after the last of them (fixture test_renders).
+# SLOW_UNDER_SANITIZERS: a --gtest_filter of the unit tests that take minutes
+# under ASan ("*": all of them); the sanitizer build (IRBENCH_SANITIZE) leaves
+# them out, and a build with IRBENCH_UNIT_TESTS=OFF builds and runs only them:
+# CI's two builds (ci/test.sh) run every unit test once between them.
 function(irbench_test name)
-  cmake_parse_arguments(ARG "SHARED_RENDERS" "COST" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "SHARED_RENDERS" "COST;SLOW_UNDER_SANITIZERS" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT ARG_LABELS)
     file(RELATIVE_PATH rel_dir "${PROJECT_SOURCE_DIR}" "${CMAKE_CURRENT_SOURCE_DIR}")
     if(rel_dir STREQUAL "tests" OR rel_dir MATCHES "^tests/")
@@ -17,6 +22,19 @@ function(irbench_test name)
     else()
       set(ARG_LABELS unit)
     endif()
+  endif()
+  set(filter "")
+  if(ARG_LABELS STREQUAL "unit" AND IRBENCH_SANITIZE)
+    if(ARG_SLOW_UNDER_SANITIZERS STREQUAL "*")
+      return()
+    elseif(ARG_SLOW_UNDER_SANITIZERS)
+      set(filter "-${ARG_SLOW_UNDER_SANITIZERS}")
+    endif()
+  elseif(ARG_LABELS STREQUAL "unit" AND NOT IRBENCH_UNIT_TESTS)
+    if(NOT ARG_SLOW_UNDER_SANITIZERS)
+      return()
+    endif()
+    set(filter "${ARG_SLOW_UNDER_SANITIZERS}")
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
@@ -38,7 +56,11 @@ function(irbench_test name)
       set_tests_properties(TestRenders.ClearAfter PROPERTIES FIXTURES_CLEANUP test_renders)
     endif()
   endif()
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES ${properties})
+  if(filter)
+    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 TEST_FILTER "${filter}" PROPERTIES ${properties})
+  else()
+    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES ${properties})
+  endif()
   # `cmake --build <dir> --target irbench_unit_tests` builds the "unit" ones only.
   if(ARG_LABELS STREQUAL "unit")
     if(NOT TARGET irbench_unit_tests)
