@@ -291,7 +291,7 @@ Score ScoreTrack(const fs::path& truth_jsonl, const fs::path& track_jsonl, const
   std::map<std::string, std::vector<double>> joint_errors, pointing_errors;
   std::map<std::string, std::vector<int>> joint_frames, pointing_frames;
   std::map<std::string, int> joint_missing, pointing_missing;
-  GestureRuns gestures{&score};
+  GestureRuns gestures{.score = &score};
   for (const auto& [frame, truth] : truth_by_frame) {
     if (!Flag(truth, "present", truth_jsonl).value_or(false)) continue;
     ++score.present_frames;

@@ -825,7 +825,7 @@ MotionPtr BuildLibraryMotion(const std::string& name, const nlohmann::json& para
     if (!params.is_object() || !params.contains("to")) b.Fail("to", "required: [x, y] metres");
     std::optional<double> heading;
     if (params.contains("heading_deg")) heading = Param(params, "heading_deg", 0, b, -360, 360);
-    return Walk("walk", PointParam(params, "to", {}, b), heading, b, Param(params, "speed", 1.0, b, 0.2, 3.0));
+    return Walk("walk", PointParam(params, "to", Eigen::Vector2d::Zero(), b), heading, b, Param(params, "speed", 1.0, b, 0.2, 3.0));
   }
   if (name == "turn") {
     CheckKeys(params, {"heading_deg"}, b);

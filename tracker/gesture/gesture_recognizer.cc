@@ -13,21 +13,24 @@ GestureRecognizer::GestureRecognizer(std::shared_ptr<const GestureModels> models
   for (int g = 0; g < models_->gesture_count(); ++g) {
     switch (kind) {
       case GestureModelKind::kHmm: {
-        Stream s{g, models_->hmm[g].chain, models_->hmm[g].means, models_->hmm[g].covariance};
-        streams_.push_back(s);
+        streams_.push_back(Stream{.gesture = g,
+                                  .chain = models_->hmm[g].chain,
+                                  .means = models_->hmm[g].means,
+                                  .covariance = models_->hmm[g].covariance});
         break;
       }
       case GestureModelKind::kFactorialHmm: {
         const Fhmm& f = models_->fhmm[g];
-        streams_.push_back(Stream{g, f.ProductChain(), f.ProductMeans(), f.covariance});
+        streams_.push_back(
+            Stream{.gesture = g, .chain = f.ProductChain(), .means = f.ProductMeans(), .covariance = f.covariance});
         break;
       }
       case GestureModelKind::kParallelHmm:
         for (int c = 0; c < 2; ++c) {
-          Stream s{g, models_->pahmm[g][c].chain};
-          s.log_emission = models_->pahmm[g][c].log_emission;
-          s.primary = c == 0;
-          streams_.push_back(s);
+          streams_.push_back(Stream{.gesture = g,
+                                    .chain = models_->pahmm[g][c].chain,
+                                    .log_emission = models_->pahmm[g][c].log_emission,
+                                    .primary = c == 0});
         }
         break;
     }
