@@ -32,14 +32,32 @@ Eigen::Vector3f ChannelReflectance(const NirReflectance& r) {
   return {r.at_850, r.at_940, 0.5f * (r.at_850 + r.at_940)};
 }
 
-// Light from patch `k` onto a point `p` facing `n` (n unit; cosines clamped).
-// The two faces' signs are checked before the square root (most pairs in a
-// room face away or lie in one wall); the arithmetic is the same either way.
-inline double Transfer(const BouncePatch& k, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
-  const Eigen::Vector3d d = k.center - p;  // point -> patch
-  const double toward_p = -k.normal.dot(d), toward_k = n.dot(d);
+// A patch as the gathers read it: plain doubles, so that the inner loops
+// compile to straight arithmetic in every build (Eigen's 3-vector expressions
+// stay calls under the sanitizers, where they took most of a render test's
+// time). The arithmetic, operation for operation and in the same order, is
+// Eigen's on the BouncePatch: the same bytes.
+struct Emitter {
+  double cx, cy, cz;  // centre
+  double nx, ny, nz;  // unit normal
+  double area;
+  double r0, r1, r2;  // radiosity per channel
+};
+
+Emitter EmitterOf(const BouncePatch& k) {
+  return {k.center.x(), k.center.y(), k.center.z(), k.normal.x(), k.normal.y(), k.normal.z(), k.area,
+          static_cast<double>(k.radiosity[0]), static_cast<double>(k.radiosity[1]), static_cast<double>(k.radiosity[2])};
+}
+
+// Light from patch `k` onto a point (px, py, pz) facing (qx, qy, qz) (unit;
+// cosines clamped). The two faces' signs are checked before the square root
+// (most pairs in a room face away or lie in one wall); the arithmetic is the
+// same either way.
+inline double Transfer(const Emitter& k, double px, double py, double pz, double qx, double qy, double qz) {
+  const double dx = k.cx - px, dy = k.cy - py, dz = k.cz - pz;  // point -> patch
+  const double toward_p = -(k.nx * dx + k.ny * dy + k.nz * dz), toward_k = qx * dx + qy * dy + qz * dz;
   if (toward_p <= 0 || toward_k <= 0) return 0;
-  const double r2 = d.squaredNorm();
+  const double r2 = dx * dx + dy * dy + dz * dz;
   if (r2 <= 1e-12) return 0;
   const double r = std::sqrt(r2);
   const double cos_p = toward_p / r;
@@ -104,17 +122,21 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
   for (int bounce = 1; bounce < options.bounces; ++bounce) {
     std::vector<Eigen::Vector3f> next(patches.size());
     // Only lit patches are gathered from (a dark one would add exact zeros).
-    std::vector<const BouncePatch*> lit;
+    std::vector<Emitter> lit;
     for (const BouncePatch& k : patches) {
-      if (GivesLight(k)) lit.push_back(&k);
+      if (GivesLight(k)) lit.push_back(EmitterOf(k));
     }
     cv::parallel_for_(cv::Range(0, static_cast<int>(patches.size())), [&](const cv::Range& range) {
       for (int j = range.start; j < range.end; ++j) {
-        Eigen::Vector3d gathered = Eigen::Vector3d::Zero();
-        for (const BouncePatch* k : lit) {
-          const double f = Transfer(*k, patches[j].center, patches[j].normal);
-          if (f > 0) gathered += f * k->radiosity.cast<double>();
+        const Eigen::Vector3d& p = patches[j].center;
+        const Eigen::Vector3d& n = patches[j].normal;
+        const double px = p.x(), py = p.y(), pz = p.z(), qx = n.x(), qy = n.y(), qz = n.z();
+        double g0 = 0, g1 = 0, g2 = 0;
+        for (const Emitter& k : lit) {
+          const double f = Transfer(k, px, py, pz, qx, qy, qz);
+          if (f > 0) g0 += f * k.r0, g1 += f * k.r1, g2 += f * k.r2;
         }
+        const Eigen::Vector3d gathered(g0, g1, g2);
         next[j] = ChannelReflectance(patches[j].reflectance).cwiseProduct(direct[j] + gathered.cast<float>());
         next[j][kScreenContent] += patches[j].content;
       }
@@ -204,29 +226,40 @@ IrradianceVolume ComputeBounceVolume(const TriangleMesh& mesh,
   const int nx = volume.dims.x(), ny = volume.dims.y(), nz = volume.dims.z();
   const size_t points = size_t(nx) * ny * nz;
   volume.values.assign(6 * points, Eigen::Vector3f::Zero());
+  std::vector<Emitter> emitters;
+  emitters.reserve(patches.size());
+  for (const BouncePatch& k : patches) emitters.push_back(EmitterOf(k));
   cv::parallel_for_(cv::Range(0, static_cast<int>(points)), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const int x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
       const Eigen::Vector3d p = volume.origin + options.grid_m * Eigen::Vector3d(x, y, z);
-      Eigen::Vector3d e[6];
-      for (auto& v : e) v.setZero();
-      for (const BouncePatch& k : patches) {
-        const Eigen::Vector3d d = k.center - p;
-        const double toward_p = -k.normal.dot(d);
+      const double px = p.x(), py = p.y(), pz = p.z();
+      // e[dir][channel], dir = +x, -x, +y, -y, +z, -z.
+      double e[6][3] = {};
+      for (const Emitter& k : emitters) {
+        const double d[3] = {k.cx - px, k.cy - py, k.cz - pz};
+        const double toward_p = -(k.nx * d[0] + k.ny * d[1] + k.nz * d[2]);
         if (toward_p <= 0) continue;  // p behind the patch (before the root)
-        const double r2 = d.squaredNorm();
+        const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if (r2 <= 1e-12) continue;
         const double r = std::sqrt(r2);
         const double cos_p = toward_p / r;
         if (cos_p <= 0) continue;
         const double w = k.area * cos_p / ((M_PI * r2 + k.area) * r);  // times d·axis
-        const Eigen::Vector3d light = w * k.radiosity.cast<double>();
+        const double light[3] = {w * k.r0, w * k.r1, w * k.r2};
         for (int axis = 0; axis < 3; ++axis) {
           const double c = d[axis];
-          if (c > 0) e[2 * axis] += c * light; else e[2 * axis + 1] -= c * light;
+          double* out = e[c > 0 ? 2 * axis : 2 * axis + 1];
+          if (c > 0) {
+            for (int ch = 0; ch < 3; ++ch) out[ch] += c * light[ch];
+          } else {
+            for (int ch = 0; ch < 3; ++ch) out[ch] -= c * light[ch];
+          }
         }
       }
-      for (int dir = 0; dir < 6; ++dir) volume.values[dir * points + i] = e[dir].cast<float>();
+      for (int dir = 0; dir < 6; ++dir) {
+        volume.values[dir * points + i] = Eigen::Vector3d(e[dir][0], e[dir][1], e[dir][2]).cast<float>();
+      }
     }
   });
   return volume;
