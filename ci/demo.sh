@@ -6,6 +6,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./ci/install_deps.sh
-./ci/configure.sh build -DCMAKE_BUILD_TYPE=Release
+./ci/configure.sh build -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON
 cmake --build build -j"$(nproc)"
 ./build/irbench demo --force "$@"

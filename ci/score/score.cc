@@ -254,8 +254,8 @@ void ScorePosture(const Json* truth_labels, const Json* track, Score* score) {
 // Gestures (thesis 5.3): the truth's runs of one gesture label, each
 // identified as the last label the track reports within it.
 struct GestureRuns {
-  Score* score;
-  std::string gesture, label;  // the current run's truth and latest tracked label
+  Score* score = nullptr;
+  std::string gesture{}, label{};  // the current run's truth and latest tracked label
 
   void Add(int frame, const Json* truth_labels, const Json* track) {
     const Json* truth_gesture = truth_labels ? Child(*truth_labels, "gesture") : nullptr;

@@ -48,13 +48,15 @@ class GestureRecognizer {
  private:
   // One chain of one gesture's model and how it scores a frame.
   struct Stream {
-    int gesture;
-    LogMarkovChain chain;
-    Eigen::MatrixXd means;       // Gaussian: D x N (empty for a discrete chain)
-    Eigen::MatrixXd covariance;  // Gaussian
-    Eigen::MatrixXd log_emission;  // discrete: N x symbols
-    bool primary = true;           // discrete: which atom it reads
-    Eigen::VectorXd log_alpha;     // the forward variables so far
+    // Every member initialised here: the constructor names only those its
+    // kind of model uses.
+    int gesture = 0;
+    LogMarkovChain chain{};
+    Eigen::MatrixXd means{};         // Gaussian: D x N (empty for a discrete chain)
+    Eigen::MatrixXd covariance{};    // Gaussian
+    Eigen::MatrixXd log_emission{};  // discrete: N x symbols
+    bool primary = true;             // discrete: which atom it reads
+    Eigen::VectorXd log_alpha{};     // the forward variables so far
   };
   Eigen::VectorXd EmissionOf(const Stream& s, const GestureObservation& o) const;
   void Advance(const GestureObservation& o);
