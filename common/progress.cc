@@ -39,8 +39,8 @@ double Progress::ElapsedS() const {
 
 std::string Progress::Line(const std::string& what, const std::string& phase, int done, int total,
                            double elapsed_s, const std::string& unit) {
-  std::string line = what + ": " + (phase.empty() ? "" : phase + " ") + std::to_string(done) + "/" +
-                     std::to_string(total);
+  std::string line = what + ": " + (phase.empty() ? "" : phase + " ") + std::to_string(done);
+  if (total > 0) line += "/" + std::to_string(total);
   char buffer[128];
   if (total > 0) {
     std::snprintf(buffer, sizeof(buffer), " (%d %%)", static_cast<int>(100.0 * done / total));
@@ -63,7 +63,7 @@ void Progress::Set(int done, const std::string& phase) {
   if (!Log().should_log(spdlog::level::info) || (quiet_scopes > 0 && !ignore_quiet_)) return;
   const auto now = std::chrono::steady_clock::now();
   const double since = std::chrono::duration<double>(now - last_).count();
-  const bool last = done >= total_;
+  const bool last = total_ > 0 && done >= total_;
   if (terminal_) {
     if (since < 0.2 && !last) return;
     last_ = now;

@@ -12,7 +12,8 @@ namespace irbench {
 class Progress {
  public:
   // `what`: the command ("render"); `unit`: what is counted, plural
-  // ("frame-sets"); `total`: how many there will be.
+  // ("frame-sets"); `total`: how many there will be (0: not known, as for a
+  // live capture: the count and rate without a share or time left).
   Progress(std::string what, std::string unit, int total);
   Progress(std::string what, std::string unit, int total, bool terminal, double plain_period_s);
   ~Progress();

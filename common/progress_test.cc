@@ -21,6 +21,8 @@ TEST(ProgressTest, LineGivesCountShareRateAndTimeLeft) {
   EXPECT_EQ(Progress::Line("suite s", "scenarios done", 3, 3, 30.0, "scenarios"),
             "suite s: scenarios done 3/3 (100 %), 0.1 scenarios/s");
   EXPECT_EQ(Progress::Line("render", "background", 0, 10, 0.0, "frame-sets"), "render: background 0/10 (0 %)");
+  // An unknown total (a live capture): the count and the rate only.
+  EXPECT_EQ(Progress::Line("live", "frame", 40, 0, 4.0, "frame-sets"), "live: frame 40, 10.0 frame-sets/s");
 }
 
 // Captures what the logger writes while it lives.

@@ -4,6 +4,9 @@
 // quality 90 in a recording's layout (videos/, background/, EasyMocap
 // intri.yml and extri.yml, no cameras.json) it tracks within 10 % of the
 // PNG track's joint error; bad videos are one InputError naming the video.
+// Played as a live rig's capture devices (irbench live --capture, 33.2), the
+// videos give the same track again, with the empty stage from the folder's
+// background videos or captured first.
 
 #include <gtest/gtest.h>
 
@@ -20,6 +23,7 @@
 #include "tests/test_util.h"
 #include "tests/track_figures.h"
 #include "tracker/io/sequence_input.h"
+#include "tracker/live/live_job.h"
 #include "tracker/pipeline/track_job.h"
 
 namespace irbench {
@@ -201,6 +205,154 @@ TEST_F(VideoInputTest, TheEmptyStageAsATimeRangeOfTheVideos) {
   EXPECT_EQ(cv::norm(in.Background(3, 7), seq.Background(3, 7), cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(in.Frame(3, 12 + 20), seq.Frame(3, 20), cv::NORM_INF), 0.0);
   EXPECT_THROW(SequenceInput::Open(rec, EmptyStage(100.0, 200.0)), InputError);
+}
+
+// Writes one FFV1 video per camera under `folder`: `backgrounds` empty-stage
+// frames of the sequence, then its first `frames` frames.
+void WriteCameraVideos(const fs::path& seq, const std::vector<std::string>& cameras, const fs::path& folder,
+                       int backgrounds, int frames) {
+  fs::create_directories(folder);
+  const auto grey = [](const fs::path& file) { return cv::imread(file.string(), cv::IMREAD_GRAYSCALE); };
+  for (const std::string& cam : cameras) {
+    cv::VideoWriter writer((folder / (cam + ".mkv")).string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'),
+                           30, cv::Size(320, 240), false);
+    ASSERT_TRUE(writer.isOpened());
+    for (int i = 0; i < backgrounds; ++i) writer.write(grey(seq / "background" / cam / FrameFileName(i, "png")));
+    for (int i = 0; i < frames; ++i) writer.write(grey(seq / "frames" / cam / FrameFileName(i, "png")));
+  }
+}
+
+// The live rig's folder: the sequence's calibration and screens (and its background
+// videos, when `with_background`).
+fs::path RigFolder(const fs::path& seq, const fs::path& rig, const std::vector<std::string>& cameras,
+                   bool with_background) {
+  fs::create_directories(rig / "calib");
+  for (const char* f : {"intri.yml", "extri.yml", "cameras.json", "screens.json"}) {
+    fs::copy_file(seq / "calib" / f, rig / "calib" / f);
+  }
+  if (with_background) {
+    fs::create_directories(rig / "background");
+    for (const std::string& cam : cameras) {
+      fs::copy_file(seq / "background" / (cam + ".mkv"), rig / "background" / (cam + ".mkv"));
+    }
+  }
+  return rig;
+}
+
+TEST_F(VideoInputTest, CaptureDevicesTrackAsTheRecordingDoes) {
+  // Each camera's video opened as its capture device (a V4L2 camera, a
+  // stream or a file: all cv::VideoCapture), read at 6 frame-sets/s, well
+  // under what the tracker keeps up with on a loaded machine, so none is
+  // dropped and the record is the track of the same 24 frame-sets from the
+  // PNG files, line for line, motion labels included.
+  constexpr int kFrames = 24;
+  const fs::path rig = RigFolder(*seq_, *dir_ / "rig", Cameras(), true);
+  LiveJobOptions live;
+  live.source = rig;
+  for (const std::string& cam : Cameras()) {
+    live.capture.push_back(ParseCaptureSource(cam + "=" + (*seq_ / "videos" / (cam + ".mkv")).string()));
+  }
+  live.osc = ParseOscTarget("127.0.0.1:9", "--osc");
+  live.fps = 6;
+  live.frames = kFrames;
+  live.record = *dir_ / "capture.jsonl";
+  const LiveReport report = RunLiveJob(live);
+  EXPECT_EQ(report.empty_stage, 0);  // from the folder's background videos
+  EXPECT_EQ(report.arrived, kFrames);
+  ASSERT_EQ(report.dropped, 0);
+  std::vector<nlohmann::json> record = ReadJsonLines(live.record);
+  TrackJobOptions track;
+  track.sequence = *seq_;
+  track.frames = kFrames;
+  track.out = *dir_ / "capture-reference";
+  std::vector<nlohmann::json> png = ReadJsonLines(RunTrackJob(track) / "track.jsonl");
+  ASSERT_EQ(record.size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    record[i].erase("ms");
+    png[i].erase("ms");
+    EXPECT_EQ(record[i], png[i]) << "frame " << i;
+  }
+
+  // The empty stage captured first: 12 frame-sets (0.4 s at 30 fps) of the
+  // empty stage, then the sequence, from one video per camera; tracking
+  // starts after them, the frame-sets numbered from the capture's start.
+  const fs::path rig2 = RigFolder(*seq_, *dir_ / "rig2", Cameras(), false);
+  WriteCameraVideos(*seq_, Cameras(), *dir_ / "devices2", 12, kFrames);
+  live.source = rig2;
+  live.capture.clear();
+  for (const std::string& cam : Cameras()) {
+    live.capture.push_back(ParseCaptureSource(cam + "=" + (*dir_ / "devices2" / (cam + ".mkv")).string()));
+  }
+  live.frames.reset();  // until the videos end
+  live.input.empty_stage_s = std::pair{0.0, 0.4};
+  live.record = *dir_ / "capture2.jsonl";
+  const LiveReport report2 = RunLiveJob(live);
+  EXPECT_EQ(report2.empty_stage, 12);
+  EXPECT_EQ(report2.arrived, kFrames);
+  ASSERT_EQ(report2.dropped, 0);
+  std::vector<nlohmann::json> record2 = ReadJsonLines(live.record);
+  ASSERT_EQ(record2.size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    EXPECT_EQ(record2[i]["frame"], 12 + i);
+    EXPECT_EQ(record2[i]["joints3d"], png[i]["joints3d"]) << "frame " << i;
+  }
+}
+
+// Expects `live` to throw an InputError whose message holds each of `parts`,
+// and to write no record.
+void ExpectLiveRefused(const LiveJobOptions& live, const std::vector<std::string>& parts) {
+  try {
+    RunLiveJob(live);
+    ADD_FAILURE() << "ran";
+  } catch (const InputError& e) {
+    for (const std::string& part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(live.record));
+}
+
+TEST_F(VideoInputTest, BadCaptureSourcesAreOneErrorNamingTheOption) {
+  EXPECT_THROW(ParseCaptureSource("front_left"), InputError);
+  EXPECT_THROW(ParseCaptureSource("=0"), InputError);
+  EXPECT_THROW(ParseCaptureSource("front_left="), InputError);
+  const fs::path rig = RigFolder(*seq_, *dir_ / "badrig", Cameras(), true);
+  LiveJobOptions live;
+  live.source = rig;
+  live.osc = ParseOscTarget("127.0.0.1:9", "--osc");
+  live.record = *dir_ / "refused.jsonl";
+  const auto device = [&](const std::string& cam) { return (*seq_ / "videos" / (cam + ".mkv")).string(); };
+  for (const std::string& cam : Cameras()) live.capture.push_back({cam, device(cam)});
+  // A camera without a source.
+  LiveJobOptions missing = live;
+  missing.capture.pop_back();
+  ExpectLiveRefused(missing, {"--capture", "side"});
+  // A camera the calibration lacks; the same camera twice.
+  LiveJobOptions unknown = live;
+  unknown.capture.push_back({"back", device("side")});
+  ExpectLiveRefused(unknown, {"--capture", "back"});
+  LiveJobOptions twice = live;
+  twice.capture.push_back({"side", device("side")});
+  ExpectLiveRefused(twice, {"--capture", "side", "twice"});
+  // A device that cannot be opened.
+  LiveJobOptions absent = live;
+  absent.capture[2].device = (*dir_ / "no_such_camera.mkv").string();
+  ExpectLiveRefused(absent, {"--capture", "no_such_camera.mkv"});
+  // Frames of another size than calib/cameras.json's.
+  LiveJobOptions big = live;
+  WriteMjpeg({}, 5, *dir_ / "big" / "side.avi", 90, {640, 480});
+  big.capture[3].device = (*dir_ / "big" / "side.avi").string();
+  ExpectLiveRefused(big, {"--capture", "side.avi", "640x480"});
+  // No empty stage: neither background videos nor --empty-stage.
+  LiveJobOptions bare = live;
+  bare.source = RigFolder(*seq_, *dir_ / "bare", Cameras(), false);
+  ExpectLiveRefused(bare, {"--empty-stage"});
+  // An empty stage longer than the capture.
+  LiveJobOptions short_capture = bare;
+  short_capture.input.empty_stage_s = std::pair{0.0, 100.0};
+  ExpectLiveRefused(short_capture, {"--empty-stage", "ended"});
+  // --from-videos is for recordings.
+  LiveJobOptions videos = live;
+  videos.input.videos = true;
+  ExpectLiveRefused(videos, {"--from-videos"});
 }
 
 // Expects Open to throw an InputError whose message names `file`.

@@ -9,6 +9,7 @@
 #include "common/error.h"
 #include "sequence_format/calibration.h"
 #include "sequence_format/screens.h"
+#include "tracker/io/grey_frame.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -74,21 +75,6 @@ std::string SizeMismatch(const std::string& what, cv::Size size, const Camera& c
          std::to_string(cam.width) + "x" + std::to_string(cam.height);
 }
 
-// 8-bit grey from a decoded video frame (FFmpeg hands grey videos back as BGR
-// with equal channels, which this keeps exactly).
-cv::Mat GreyOf(const cv::Mat& decoded) {
-  cv::Mat grey;
-  if (decoded.channels() == 3) {
-    cv::cvtColor(decoded, grey, cv::COLOR_BGR2GRAY);
-  } else if (decoded.channels() == 4) {
-    cv::cvtColor(decoded, grey, cv::COLOR_BGRA2GRAY);
-  } else {
-    grey = decoded;
-  }
-  if (grey.depth() == CV_16U) grey.convertTo(grey, CV_8U, 1.0 / 257.0);
-  return grey;
-}
-
 }  // namespace
 
 // One camera's video, decoded forwards; reading an earlier frame reopens it.
@@ -150,10 +136,10 @@ struct SequenceInput::Video {
   }
 };
 
-void SequenceInput::OpenVideos(SequenceInput& in, const SequenceInputOptions& options) {
+void SequenceInput::ReadRig(SequenceInput& in) {
   const fs::path& dir = in.dir_;
-  const bool has_cameras_json = fs::is_regular_file(dir / kCamerasFile);
-  if (has_cameras_json) {
+  in.has_cameras_json_ = fs::is_regular_file(dir / kCamerasFile);
+  if (in.has_cameras_json_) {
     Calibration calibration = ReadCalibration(dir);
     in.cameras_ = std::move(calibration.cameras);
     in.timing_ = std::move(calibration.timing);
@@ -167,30 +153,38 @@ void SequenceInput::OpenVideos(SequenceInput& in, const SequenceInputOptions& op
   if (in.screens_.empty() && fs::is_regular_file(dir / "screens.json")) {
     throw InputError((dir / "screens.json").string(), "", "screens belong in calib/screens.json");
   }
-  const auto open_all = [&](const fs::path& folder, bool required) {
-    std::vector<std::shared_ptr<Video>> videos;
-    for (const Camera& cam : in.cameras_) {
-      const fs::path file = VideoOf(folder, cam.name);
-      if (file.empty()) {
-        if (!required && videos.empty()) return videos;
-        throw InputError(folder.string(), "", "no video for camera '" + cam.name + "' (" + cam.name + ".mkv, .avi, .mp4, ...)");
-      }
-      videos.push_back(std::make_shared<Video>(file));
+}
+
+std::vector<std::shared_ptr<SequenceInput::Video>> SequenceInput::OpenCameraVideos(const fs::path& folder,
+                                                                                  bool required) const {
+  std::vector<std::shared_ptr<Video>> videos;
+  for (const Camera& cam : cameras_) {
+    const fs::path file = VideoOf(folder, cam.name);
+    if (file.empty()) {
+      if (!required && videos.empty()) return videos;
+      throw InputError(folder.string(), "", "no video for camera '" + cam.name + "' (" + cam.name + ".mkv, .avi, .mp4, ...)");
     }
-    // Every camera the same number of frames: a recording cut short is
-    // not a rig that lost frames.
-    for (size_t c = 1; c < videos.size(); ++c) {
-      if (videos[c]->count != videos[0]->count) {
-        const auto& shorter = videos[c]->count < videos[0]->count ? videos[c] : videos[0];
-        throw InputError(shorter->path.string(), "",
-                         "has " + std::to_string(shorter->count) + " frames; " +
-                             (shorter == videos[c] ? videos[0] : videos[c])->path.filename().string() + " has " +
-                             std::to_string(std::max(videos[c]->count, videos[0]->count)));
-      }
+    videos.push_back(std::make_shared<Video>(file));
+  }
+  // Every camera the same number of frames: a recording cut short is
+  // not a rig that lost frames.
+  for (size_t c = 1; c < videos.size(); ++c) {
+    if (videos[c]->count != videos[0]->count) {
+      const auto& shorter = videos[c]->count < videos[0]->count ? videos[c] : videos[0];
+      throw InputError(shorter->path.string(), "",
+                       "has " + std::to_string(shorter->count) + " frames; " +
+                           (shorter == videos[c] ? videos[0] : videos[c])->path.filename().string() + " has " +
+                           std::to_string(std::max(videos[c]->count, videos[0]->count)));
     }
-    return videos;
-  };
-  in.videos_ = open_all(dir / "videos", true);
+  }
+  return videos;
+}
+
+void SequenceInput::OpenVideos(SequenceInput& in, const SequenceInputOptions& options) {
+  const fs::path& dir = in.dir_;
+  ReadRig(in);
+  const bool has_cameras_json = in.has_cameras_json_;
+  in.videos_ = in.OpenCameraVideos(dir / "videos", true);
   for (size_t c = 0; c < in.cameras_.size(); ++c) {
     Camera& cam = in.cameras_[c];
     const Video& video = *in.videos_[c];
@@ -220,19 +214,57 @@ void SequenceInput::OpenVideos(SequenceInput& in, const SequenceInputOptions& op
     in.background_count_ = end - first;
     return;
   }
-  in.background_videos_ = open_all(dir / "background", false);
-  if (in.background_videos_.empty()) {
-    throw InputError((dir / "background").string(), "",
+  in.OpenEmptyStageVideos();
+}
+
+void SequenceInput::OpenEmptyStageVideos() {
+  background_videos_ = OpenCameraVideos(dir_ / "background", false);
+  if (background_videos_.empty()) {
+    throw InputError((dir_ / "background").string(), "",
                      "no empty-stage videos (background/<camera>.mkv, ...); give the empty stage as a time "
                      "range of the videos with --empty-stage FROM:TO (seconds)");
   }
-  for (size_t c = 0; c < in.cameras_.size(); ++c) {
-    const Video& video = *in.background_videos_[c];
-    if (video.size != in.videos_[c]->size) {
-      throw InputError(video.path.string(), "", "empty-stage video's size differs from " + in.videos_[c]->path.filename().string());
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    const Video& video = *background_videos_[c];
+    if (!videos_.empty() && video.size != videos_[c]->size) {
+      throw InputError(video.path.string(), "", "empty-stage video's size differs from " + videos_[c]->path.filename().string());
+    }
+    if (const std::string problem = SizeMismatch("empty-stage video", video.size, cameras_[c]); !problem.empty()) {
+      throw InputError(video.path.string(), "", problem);
     }
   }
-  in.background_count_ = in.background_videos_[0]->count;
+  background_count_ = background_videos_[0]->count;
+}
+
+SequenceInput SequenceInput::OpenRig(const fs::path& dir) {
+  SequenceInput in;
+  in.dir_ = dir;
+  if (!fs::is_directory(dir)) throw InputError(dir.string(), "", "no such rig folder");
+  ReadRig(in);
+  in.missing_frames_.assign(in.cameras_.size(), 0);
+  return in;
+}
+
+void SequenceInput::UseCaptureFormat(const std::vector<cv::Size>& sizes,
+                                     double fps,
+                                     const std::vector<std::string>& devices) {
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    if (has_cameras_json_) {
+      if (const std::string problem = SizeMismatch("its frame", sizes.at(c), cameras_[c]); !problem.empty()) {
+        throw InputError(devices.at(c), "--capture", "camera '" + cameras_[c].name + "': " + problem);
+      }
+      continue;
+    }
+    cameras_[c].width = sizes.at(c).width;
+    cameras_[c].height = sizes.at(c).height;
+    timing_[c].fps = fps;
+  }
+}
+
+void SequenceInput::UseEmptyStage(std::vector<std::vector<cv::Mat>> frames, std::vector<std::string> sources) {
+  held_backgrounds_ = std::move(frames);
+  held_background_sources_ = std::move(sources);
+  background_count_ = held_backgrounds_.empty() ? 0 : static_cast<int>(held_backgrounds_[0].size());
 }
 
 SequenceInput SequenceInput::Open(const fs::path& dir, const SequenceInputOptions& options) {
@@ -300,7 +332,8 @@ fs::path SequenceInput::FramePath(int camera, int frame) const {
 }
 
 fs::path SequenceInput::BackgroundPath(int camera, int index) const {
-  if (from_videos()) return background_videos_.at(camera)->path;
+  if (!held_backgrounds_.empty()) return held_background_sources_.at(camera);
+  if (!background_videos_.empty()) return background_videos_.at(camera)->path;
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.png", index);
   return dir_ / "background" / cameras_.at(camera).name / name;
@@ -321,7 +354,7 @@ cv::Mat SequenceInput::Load(const fs::path& path, int camera) const {
 cv::Mat SequenceInput::LoadVideoFrame(Video& video, int index, int camera) const {
   cv::Mat image;
   try {
-    image = GreyOf(video.Read(index));
+    image = GreyFrame(video.Read(index));
   } catch (const cv::Exception& e) {
     throw InputError(video.path.string(), "", "frame " + std::to_string(index) + " cannot be decoded: " + e.msg);
   }
@@ -371,7 +404,8 @@ std::vector<cv::Mat> SequenceInput::FrameSet(int frame) const {
 }
 
 cv::Mat SequenceInput::Background(int camera, int index) const {
-  if (from_videos()) return LoadVideoFrame(*background_videos_.at(camera), background_first_ + index, camera);
+  if (!held_backgrounds_.empty()) return held_backgrounds_.at(camera).at(index);
+  if (!background_videos_.empty()) return LoadVideoFrame(*background_videos_.at(camera), background_first_ + index, camera);
   return Load(BackgroundPath(camera, index), camera);
 }
 

@@ -49,6 +49,27 @@ class SequenceInput {
   // frames are InputErrors naming the video.
   static SequenceInput Open(const std::filesystem::path& dir, const SequenceInputOptions& options = {});
 
+  // A live rig's folder (`irbench live --capture`, docs/live.md): the
+  // calibration as for a recording (calib/cameras.json with calib/intri.yml
+  // and extri.yml, or EasyMocap's intri.yml and extri.yml in calib/ or the
+  // folder itself) and calib/screens.json; no frames (frame_count() is 0:
+  // they come from the capture, capture_input.h). Then UseCaptureFormat, and
+  // the empty stage from UseEmptyStage or OpenEmptyStageVideos.
+  static SequenceInput OpenRig(const std::filesystem::path& dir);
+  // The capture's image sizes and frame rate, per camera in the cameras'
+  // order: they become the cameras' where no calib/cameras.json gives them;
+  // where one does, a size that differs is an InputError on --capture naming
+  // the camera's device (`devices`).
+  void UseCaptureFormat(const std::vector<cv::Size>& sizes, double fps, const std::vector<std::string>& devices);
+  // The empty stage as captured: per camera (the cameras' order) its frames,
+  // the same number for each; `sources` names each camera's device (the
+  // front end's errors name it).
+  void UseEmptyStage(std::vector<std::vector<cv::Mat>> frames, std::vector<std::string> sources);
+  // The empty stage from background/<cam>.<ext> videos in the folder;
+  // InputError when there are none (naming --empty-stage as the other way)
+  // or one is of another size than its camera.
+  void OpenEmptyStageVideos();
+
   const std::filesystem::path& dir() const { return dir_; }
   const std::vector<Camera>& cameras() const { return cameras_; }
   int frame_count() const { return frame_count_; }
@@ -72,7 +93,8 @@ class SequenceInput {
   cv::Mat Background(int camera, int index) const;
   std::vector<cv::Mat> Backgrounds(int camera) const;
 
-  // The frame's file; from videos, the camera's video.
+  // The frame's file; from videos, the camera's video; for a captured empty
+  // stage, the camera's device.
   std::filesystem::path FramePath(int camera, int frame) const;
   std::filesystem::path BackgroundPath(int camera, int index) const;
   bool from_videos() const { return !videos_.empty(); }
@@ -80,6 +102,11 @@ class SequenceInput {
  private:
   struct Video;  // one camera's video, read forwards
   static void OpenVideos(SequenceInput& in, const SequenceInputOptions& options);
+  // The calibration and screens of a recording or a live rig.
+  static void ReadRig(SequenceInput& in);
+  // One video per camera from `folder` (<cam>.<ext>), all of the same length;
+  // none when `required` is false and the first camera has none.
+  std::vector<std::shared_ptr<Video>> OpenCameraVideos(const std::filesystem::path& folder, bool required) const;
   cv::Mat Load(const std::filesystem::path& path, int camera) const;
   cv::Mat LoadVideoFrame(Video& video, int index, int camera) const;
 
@@ -94,6 +121,11 @@ class SequenceInput {
   // same one, from `background_first_`, when given as a time range).
   std::vector<std::shared_ptr<Video>> videos_, background_videos_;
   int background_first_ = 0;
+  // A live rig: whether calib/cameras.json gave the sizes, and the empty
+  // stage as captured (per camera) with each camera's device.
+  bool has_cameras_json_ = false;
+  std::vector<std::vector<cv::Mat>> held_backgrounds_;
+  std::vector<std::string> held_background_sources_;
 };
 
 }  // namespace irbench
