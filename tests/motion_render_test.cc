@@ -186,6 +186,20 @@ TEST(MotionRenderTest, OcclusionPosesHideWhatTheySay) {
     EXPECT_GT(u, lo) << cam;
     EXPECT_LT(u, hi) << cam;
   }
+  // The truth counts the views that see each joint: the arm behind the back
+  // hides its wrist from both frontal cameras; at rest both see it.
+  EXPECT_EQ(held["arm_behind"]["views"]["right_wrist"], 0);
+  EXPECT_EQ(at_rest["arm_behind"]["views"]["right_wrist"], 2);
+  for (const auto& frames : {at_rest, held}) {
+    for (const auto& [pose, f] : frames) {
+      for (const auto& [joint, n] : f["views"].items()) {
+        int seen = 0;
+        for (const auto& [cam, joints] : f["joints2d"].items()) seen += joints[joint][2].get<int>() == 2;
+        EXPECT_EQ(n.get<int>(), seen) << pose << " " << joint;
+      }
+      EXPECT_EQ(f["views"].size(), f["joints3d"].size()) << pose;
+    }
+  }
   const auto world = [](const nlohmann::json& f, const char* joint) {
     return Eigen::Vector3d(f["joints3d"][joint][0], f["joints3d"][joint][1], f["joints3d"][joint][2]);
   };

@@ -547,15 +547,22 @@ nlohmann::json TruthLine(const RenderInputs& in,
   for (size_t j = 0; j < joint_names.size(); ++j) joints3d[joint_names[j]] = Vec(truth.joints3d[j]);
   line["joints3d"] = joints3d;
   nlohmann::json joints2d = nlohmann::json::object();
+  std::vector<int> views(joint_names.size(), 0);
   for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
     nlohmann::json per_cam = nlohmann::json::object();
     for (size_t j = 0; j < joint_names.size(); ++j) {
       const Eigen::Vector3d& uvv = truth.joints2d[c][j];
-      per_cam[joint_names[j]] = {uvv.x(), uvv.y(), static_cast<int>(uvv.z())};
+      const int vis = static_cast<int>(uvv.z());
+      per_cam[joint_names[j]] = {uvv.x(), uvv.y(), vis};
+      if (vis == 2) ++views[j];
     }
     joints2d[in.rig.cameras[c].name] = per_cam;
   }
   line["joints2d"] = joints2d;
+  // How many cameras see each joint (vis 2): how hidden a pose is.
+  nlohmann::json joint_views = nlohmann::json::object();
+  for (size_t j = 0; j < joint_names.size(); ++j) joint_views[joint_names[j]] = views[j];
+  line["views"] = joint_views;
   line["labels"] = labeler.Labels(t);
   line["pointing"] = labeler.Pointing(t);
   line["sensor"] = sensor_truth;

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <queue>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 
 namespace irbench {
@@ -230,6 +231,102 @@ struct Tree {
   }
 };
 
+// 6. The tree's segments from the root outwards; those that end at a leaf
+// are limbs, labelled; then the torso.
+std::vector<NssCurve> LabelledCurves(const std::vector<NssNode>& nodes, const Tree& tree, int root,
+                                     const Eigen::Vector2d& facing_xy, const NssOptions& options) {
+  std::vector<NssCurve> curves;
+  const double w = options.shell_width_m;
+  struct Segment {
+    std::vector<int> nodes;
+    bool limb = false;
+  };
+  std::vector<Segment> segments;
+  std::vector<int> starts{root};
+  while (!starts.empty()) {
+    const int start = starts.back();
+    starts.pop_back();
+    for (int c : tree.children[start]) {
+      if (!tree.Significant(c, w)) continue;
+      Segment s;
+      s.nodes = tree.Segment(start, c, w, &s.limb);
+      if (!s.limb) starts.push_back(s.nodes.back());
+      segments.push_back(std::move(s));
+    }
+  }
+  const auto points_of = [&](const std::vector<int>& path) {
+    std::vector<Eigen::Vector3d> points;
+    for (int n : path) points.push_back(nodes[n].p_in_world);
+    return points;
+  };
+  // Upper and lower: which side of the root (in world z) a segment's
+  // junction lies; left and right from the facing.
+  const Eigen::Vector3d root_p = nodes[root].p_in_world;
+  Eigen::Vector2d front = facing_xy.norm() > 0 ? facing_xy.normalized() : Eigen::Vector2d(0, 1);
+  const Eigen::Vector2d right(front.y(), -front.x());
+  const auto lateral = [&](const std::vector<Eigen::Vector3d>& points) {
+    const Eigen::Vector3d p = PointAlong(points, 0.15);
+    return right.dot((p - root_p).head<2>());
+  };
+  std::vector<NssCurve> upper, lower;
+  for (const Segment& s : segments) {
+    if (!s.limb) continue;
+    NssCurve curve;
+    curve.nodes = s.nodes;
+    curve.points_in_world = points_of(s.nodes);
+    curve.length_m = PolylineLength(curve.points_in_world);
+    if (curve.length_m < options.min_branch_m) continue;
+    curve.label = "limb";
+    (nodes[s.nodes.front()].p_in_world.z() >= root_p.z() ? upper : lower).push_back(std::move(curve));
+  }
+  if (upper.size() == 3) {
+    const auto head = std::min_element(upper.begin(), upper.end(),
+                                       [](const NssCurve& a, const NssCurve& b) { return a.length_m < b.length_m; });
+    head->label = "head";
+  }
+  const auto sides = [&](std::vector<NssCurve>& limbs, const std::string& kind) {
+    std::vector<NssCurve*> two;
+    for (NssCurve& c : limbs) {
+      if (c.label == "limb") two.push_back(&c);
+    }
+    if (two.size() != 2) return;
+    const bool first_right = lateral(two[0]->points_in_world) > lateral(two[1]->points_in_world);
+    two[first_right ? 0 : 1]->label = "right_" + kind;
+    two[first_right ? 1 : 0]->label = "left_" + kind;
+  };
+  sides(upper, "arm");
+  sides(lower, "leg");
+  for (NssCurve& c : upper) curves.push_back(std::move(c));
+  for (NssCurve& c : lower) curves.push_back(std::move(c));
+  // The torso: the tree's path from its lowest junction to its highest
+  // (junctions: where segments end that are not limbs; and the root).
+  int low = root, high = root;
+  for (const Segment& s : segments) {
+    if (s.limb) continue;
+    const int j = s.nodes.back();
+    if (nodes[j].p_in_world.z() < nodes[low].p_in_world.z()) low = j;
+    if (nodes[j].p_in_world.z() > nodes[high].p_in_world.z()) high = j;
+  }
+  const auto up_to_root = [&](int n) {
+    std::vector<int> path{n};
+    while (nodes[path.back()].parent >= 0) path.push_back(nodes[path.back()].parent);
+    return path;
+  };
+  std::vector<int> from_low = up_to_root(low), from_high = up_to_root(high);
+  while (from_low.size() > 1 && from_high.size() > 1 && from_low[from_low.size() - 2] == from_high[from_high.size() - 2]) {
+    from_low.pop_back();  // below their lowest common ancestor, both paths are the same
+    from_high.pop_back();
+  }
+  NssCurve torso;
+  torso.label = "torso";
+  torso.nodes = from_low;  // low ... common ancestor
+  torso.nodes.insert(torso.nodes.end(), from_high.rbegin() + 1, from_high.rend());
+  torso.points_in_world = points_of(torso.nodes);
+  torso.length_m = PolylineLength(torso.points_in_world);
+  curves.push_back(std::move(torso));
+  return curves;
+}
+
 }  // namespace
 
 void NssOptions::Check() const {
@@ -356,96 +453,37 @@ NssSkeleton ComputeNssSkeleton(const VoxelHull& hull, const Eigen::Vector2d& fac
     for (int c : tree.children[n]) tree.reach_m[n] = std::max(tree.reach_m[n], tree.reach_m[c] + options.shell_width_m);
   }
 
-  // 6. Segments from the root outwards; those that end at a leaf are limbs.
-  const double w = options.shell_width_m;
-  struct Segment {
-    std::vector<int> nodes;
-    bool limb = false;
-  };
-  std::vector<Segment> segments;
-  std::vector<int> starts{root};
-  while (!starts.empty()) {
-    const int start = starts.back();
-    starts.pop_back();
-    for (int c : tree.children[start]) {
-      if (!tree.Significant(c, w)) continue;
-      Segment s;
-      s.nodes = tree.Segment(start, c, w, &s.limb);
-      if (!s.limb) starts.push_back(s.nodes.back());
-      segments.push_back(std::move(s));
-    }
-  }
-  const auto points_of = [&](const std::vector<int>& nodes) {
-    std::vector<Eigen::Vector3d> points;
-    for (int n : nodes) points.push_back(out.nodes[n].p_in_world);
-    return points;
-  };
-  // Upper and lower: which side of the root (in world z) a segment's
-  // junction lies; left and right from the facing.
-  const Eigen::Vector3d root_p = out.nodes[root].p_in_world;
-  Eigen::Vector2d front = facing_xy.norm() > 0 ? facing_xy.normalized() : Eigen::Vector2d(0, 1);
-  const Eigen::Vector2d right(front.y(), -front.x());
-  const auto lateral = [&](const std::vector<Eigen::Vector3d>& points) {
-    const Eigen::Vector3d p = PointAlong(points, 0.15);
-    return right.dot((p - root_p).head<2>());
-  };
-  std::vector<NssCurve> upper, lower;
-  for (const Segment& s : segments) {
-    if (!s.limb) continue;
-    NssCurve curve;
-    curve.nodes = s.nodes;
-    curve.points_in_world = points_of(s.nodes);
-    curve.length_m = PolylineLength(curve.points_in_world);
-    if (curve.length_m < options.min_branch_m) continue;
-    curve.label = "limb";
-    (out.nodes[s.nodes.front()].p_in_world.z() >= root_p.z() ? upper : lower).push_back(std::move(curve));
-  }
-  if (upper.size() == 3) {
-    const auto head = std::min_element(upper.begin(), upper.end(),
-                                       [](const NssCurve& a, const NssCurve& b) { return a.length_m < b.length_m; });
-    head->label = "head";
-  }
-  const auto sides = [&](std::vector<NssCurve>& limbs, const std::string& kind) {
-    std::vector<NssCurve*> two;
-    for (NssCurve& c : limbs) {
-      if (c.label == "limb") two.push_back(&c);
-    }
-    if (two.size() != 2) return;
-    const bool first_right = lateral(two[0]->points_in_world) > lateral(two[1]->points_in_world);
-    two[first_right ? 0 : 1]->label = "right_" + kind;
-    two[first_right ? 1 : 0]->label = "left_" + kind;
-  };
-  sides(upper, "arm");
-  sides(lower, "leg");
-  for (NssCurve& c : upper) out.curves.push_back(std::move(c));
-  for (NssCurve& c : lower) out.curves.push_back(std::move(c));
-  // The torso: the tree's path from its lowest junction to its highest
-  // (junctions: where segments end that are not limbs; and the root).
-  int low = root, high = root;
-  for (const Segment& s : segments) {
-    if (s.limb) continue;
-    const int j = s.nodes.back();
-    if (out.nodes[j].p_in_world.z() < out.nodes[low].p_in_world.z()) low = j;
-    if (out.nodes[j].p_in_world.z() > out.nodes[high].p_in_world.z()) high = j;
-  }
-  const auto up_to_root = [&](int n) {
-    std::vector<int> path{n};
-    while (out.nodes[path.back()].parent >= 0) path.push_back(out.nodes[path.back()].parent);
-    return path;
-  };
-  std::vector<int> from_low = up_to_root(low), from_high = up_to_root(high);
-  while (from_low.size() > 1 && from_high.size() > 1 && from_low[from_low.size() - 2] == from_high[from_high.size() - 2]) {
-    from_low.pop_back();  // below their lowest common ancestor, both paths are the same
-    from_high.pop_back();
-  }
-  NssCurve torso;
-  torso.label = "torso";
-  torso.nodes = from_low;  // low ... common ancestor
-  torso.nodes.insert(torso.nodes.end(), from_high.rbegin() + 1, from_high.rend());
-  torso.points_in_world = points_of(torso.nodes);
-  torso.length_m = PolylineLength(torso.points_in_world);
-  out.curves.push_back(std::move(torso));
+  out.curves = LabelledCurves(out.nodes, tree, root, facing_xy, options);
   return out;
+}
+
+void WriteNssPly(const std::filesystem::path& path, const NssSkeleton& skeleton) {
+  const std::map<std::string, std::array<int, 3>> colours = {
+      {"head", {255, 255, 255}},   {"torso", {160, 160, 160}}, {"right_arm", {230, 60, 40}},
+      {"left_arm", {40, 120, 230}}, {"right_leg", {240, 170, 40}}, {"left_leg", {60, 190, 90}}};
+  std::string vertices, edges;
+  int count = 0, edge_count = 0;
+  char buffer[96];
+  for (const NssCurve& c : skeleton.curves) {
+    const auto it = colours.find(c.label);
+    const std::array<int, 3> rgb = it == colours.end() ? std::array<int, 3>{200, 0, 200} : it->second;
+    for (size_t i = 0; i < c.points_in_world.size(); ++i) {
+      const Eigen::Vector3d& p = c.points_in_world[i];
+      std::snprintf(buffer, sizeof(buffer), "%.4f %.4f %.4f %d %d %d\n", p.x(), p.y(), p.z(), rgb[0], rgb[1], rgb[2]);
+      vertices += buffer;
+      if (i > 0) {
+        edges += std::to_string(count - 1) + " " + std::to_string(count) + "\n";
+        ++edge_count;
+      }
+      ++count;
+    }
+  }
+  AtomicWriteFile(path, "ply\nformat ascii 1.0\ncomment irbench NSS skeleton (thesis 4.4.1), world metres, z up\n"
+                        "element vertex " + std::to_string(count) +
+                            "\nproperty float x\nproperty float y\nproperty float z\n"
+                            "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                            "element edge " + std::to_string(edge_count) +
+                            "\nproperty int vertex1\nproperty int vertex2\nend_header\n" + vertices + edges);
 }
 
 }  // namespace irbench

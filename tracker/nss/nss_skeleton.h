@@ -30,6 +30,7 @@
 // World frame: metres, z up. Deterministic: no random draws.
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,11 @@ struct NssSkeleton {
 // person's front in the world's xy plane (need not be unit). An empty
 // skeleton (no nodes) for a hull with fewer voxels than landmarks.
 NssSkeleton ComputeNssSkeleton(const VoxelHull& hull, const Eigen::Vector2d& facing_xy, const NssOptions& options = {});
+
+// The curves as a PLY polyline set (ASCII: float x y z and uchar red green
+// blue per vertex, one colour per label; an edge between consecutive points
+// of a curve), which MeshLab and Blender open; written atomically.
+void WriteNssPly(const std::filesystem::path& path, const NssSkeleton& skeleton);
 
 // Geodesic distances (metres along the 26-neighbour graph of `centres`, on
 // a grid of `voxel_size_m`) from voxel `from` to every voxel; infinity where

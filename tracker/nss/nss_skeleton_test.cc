@@ -7,7 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include "common/error.h"
 #include "tracker/nss/stick_figure.h"
@@ -112,6 +117,38 @@ TEST(NssSkeletonTest, IsomapStraightensABentTube) {
   const double embedded = (embedded_at(hull.VoxelCenter(1, 1, 23)) - embedded_at(hull.VoxelCenter(18, 1, 23))).norm();
   std::printf("ends: %.2f m apart, %.2f m along the tube, %.2f m in the embedding\n", euclid, along, embedded);
   EXPECT_GT(embedded, 0.85 * along);
+}
+
+TEST(NssSkeletonTest, PlyHoldsEveryCurvePointAndTheEdgesBetweenThem) {
+  const StickFigure figure = MakeStickFigure({0.45, 0, 1.55}, {0.65, 0, 1.75}, {-0.3, 0.1, 1.15}, {-0.26, 0.37, 1.15});
+  const NssSkeleton skeleton = ComputeNssSkeleton(figure.hull, {0, 1});
+  const std::filesystem::path path = std::filesystem::temp_directory_path() / ("nss_" + std::to_string(getpid()) + ".ply");
+  WriteNssPly(path, skeleton);
+  std::ifstream in(path);
+  std::string line;
+  int vertices = -1, edges = -1;
+  while (std::getline(in, line) && line != "end_header") {
+    std::sscanf(line.c_str(), "element vertex %d", &vertices);
+    std::sscanf(line.c_str(), "element edge %d", &edges);
+  }
+  size_t points = 0, segments = 0;
+  for (const NssCurve& c : skeleton.curves) points += c.points_in_world.size(), segments += c.points_in_world.size() - 1;
+  EXPECT_EQ(vertices, static_cast<int>(points));
+  EXPECT_EQ(edges, static_cast<int>(segments));
+  // The first vertex is the first curve's first point; the edges join its neighbours.
+  double x, y, z;
+  int r, g, b;
+  ASSERT_TRUE(std::getline(in, line));
+  ASSERT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %d %d %d", &x, &y, &z, &r, &g, &b), 6);
+  EXPECT_NEAR(x, skeleton.curves[0].points_in_world[0].x(), 1e-4);
+  EXPECT_NEAR(z, skeleton.curves[0].points_in_world[0].z(), 1e-4);
+  for (int i = 1; i < vertices; ++i) std::getline(in, line);
+  int a = -1, c = -1;
+  ASSERT_TRUE(std::getline(in, line));
+  ASSERT_EQ(std::sscanf(line.c_str(), "%d %d", &a, &c), 2);
+  EXPECT_EQ(a, 0);
+  EXPECT_EQ(c, 1);
+  std::filesystem::remove(path);
 }
 
 TEST(NssSkeletonTest, SmallOrEmptyHullsGiveNoSkeletonAndBadOptionsAreRefused) {

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "common/logging.h"
+#include "tracker/body_model/body_model.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -176,6 +177,24 @@ std::optional<ShapeDescriptor> Shape(const FrameFeatures& features, const std::o
 
 // features.jsonl's summary of the descriptor (the whole one: irbench track
 // --descriptors).
+// features.jsonl's `nss`: the voxels used and each labelled curve's points
+// (world metres, to the millimetre), junction first; null without a hull.
+nlohmann::json NssJson(const std::optional<NssSkeleton>& nss) {
+  if (!nss) return nullptr;
+  nlohmann::json curves = nlohmann::json::object();
+  for (const NssCurve& c : nss->curves) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const Eigen::Vector3d& p : c.points_in_world) {
+      points.push_back({std::round(p.x() * 1e3) / 1e3, std::round(p.y() * 1e3) / 1e3, std::round(p.z() * 1e3) / 1e3});
+    }
+    // Unlabelled limbs get numbered keys: limb, limb_2, ...
+    std::string key = c.label;
+    for (int n = 2; curves.contains(key); ++n) key = c.label + "_" + std::to_string(n);
+    curves[key] = points;
+  }
+  return {{"voxels", nss->voxels}, {"nodes", nss->nodes.size()}, {"curves", curves}};
+}
+
 nlohmann::json ShapeJson(const std::optional<ShapeDescriptor>& shape) {
   if (!shape) return nullptr;
   return {{"points", shape->point_count},
@@ -224,6 +243,7 @@ FrameTracker::FrameTracker(const SequenceInput& input,
                            const FrontEndOptions& front_end_options,
                            std::shared_ptr<const RestClassifier> rest_classifier)
     : input_(input),
+      nss_(settings.nss),
       front_end_(TrainTimed(input, front_end_options, &train_ms_)),
       health_(front_end_.camera_references(), front_end_options.health),
       last_health_(input.cameras().size(), CameraHealth::kOk),
@@ -342,8 +362,16 @@ FrameTracker::Step FrameTracker::Track(int f,
                                     : step.posture && step.posture->pair == std::array<int, 2>{0, 0};
     step.gesture = gesture_recognizer_->Update(f, observation, at_rest);
   }
-  const double recognition_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shape_end).count();
+  const auto recognition_end = std::chrono::steady_clock::now();
+  const double recognition_ms = std::chrono::duration<double, std::milli>(recognition_end - shape_end).count();
+  if (nss_ && step.features.voxels && step.features.placement) {
+    // The person's front: the tracked body's yaw, else the screens' way (+y).
+    const Eigen::Vector2d facing =
+        step.pose && step.pose->tracking ? FacingDirection(step.pose->pose.dof[3]) : Eigen::Vector2d::UnitY();
+    step.nss = ComputeNssSkeleton(*step.features.voxels, facing);
+  }
+  const double nss_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - recognition_end).count();
   nlohmann::json& line = step.features_line;
   line["frame"] = f;
   line["t"] = f / input_.fps();
@@ -352,10 +380,12 @@ FrameTracker::Step FrameTracker::Track(int f,
   }
   AddHullFeatures(step.features, input_.cameras(), line);
   line["shape"] = ShapeJson(step.shape);
+  if (nss_) line["nss"] = NssJson(step.nss);
   step.track_line = TrackLine(f, f / input_.fps(), step.features, step.pose, input_.cameras(), line);
   line["ms"] = StageMs(step.features, step.pose);
   line["ms"]["shape"] = shape_ms;
   line["ms"]["postures_gestures"] = recognition_ms;
+  if (nss_) line["ms"]["nss"] = nss_ms;
   step.track_line["posture"] = PostureJson(step.posture, posture_atoms_.get());
   if (step.gesture) {
     step.track_line["gesture"] = {{"label", gesture_models_->gestures[step.gesture->gesture]},

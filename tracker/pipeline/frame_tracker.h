@@ -15,6 +15,7 @@
 #include "tracker/frontend/camera_health.h"
 #include "tracker/frontend/frontend.h"
 #include "tracker/io/sequence_input.h"
+#include "tracker/nss/nss_skeleton.h"
 #include "tracker/pipeline/track_settings.h"
 #include "tracker/pose/pose_tracker.h"
 #include "tracker/gesture/gesture_recognizer.h"
@@ -51,6 +52,8 @@ class FrameTracker {
     std::optional<Posture> posture;
     // The online gesture decision (thesis 5.2), when the tracker has models.
     std::optional<GestureDecision> gesture;
+    // The hull's NSS skeleton (thesis 4.4.1), with --nss.
+    std::optional<NssSkeleton> nss;
     // Motion labels (thesis 7.1) that became final at this frame-set, for
     // this or earlier frames (the model's window late), in frame order.
     std::vector<MotionLabeler::Labels> motion;
@@ -84,6 +87,7 @@ class FrameTracker {
   void LoadMotionLabeler(const TrackerSettings& settings);
 
   const SequenceInput& input_;
+  bool nss_ = false;  // TrackerSettings::nss
   double train_ms_ = 0;
   FrontEnd front_end_;
   std::optional<PoseTracker> pose_tracker_;

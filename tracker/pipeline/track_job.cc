@@ -172,6 +172,7 @@ void TrackFrame(int f, TrackRun& run) {
     std::snprintf(stem, sizeof(stem), "%06d", f);
     if (features.voxels) WriteVoxelCubesPly(run.root / "hull" / (std::string(stem) + "_voxels.ply"), *features.voxels);
     if (features.hull) WriteMeshPly(run.root / "hull" / (std::string(stem) + "_polyhedral.ply"), *features.hull);
+    if (step.nss) WriteNssPly(run.root / "hull" / (std::string(stem) + "_nss.ply"), *step.nss);
   }
   if (run.descriptors) {
     run.descriptors->Append(step.shape ? step.shape->bins : std::vector<float>(run.descriptor_bins, 0.0f));

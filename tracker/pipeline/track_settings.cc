@@ -110,6 +110,10 @@ std::vector<TrackSetting> MakeSettings() {
   s.push_back({"heading_from_feet", "--heading-from-screen",
                "pose: a standing user is taken to face the screens, not the way the hull's feet point",
                BoolBinding{[](TrackerSettings& t) -> bool& { return t.pose.heading_from_feet; }, false}});
+  s.push_back({"nss", "--nss",
+               "NSS skeletons (thesis 4.4.1) of the voxel hull every frame-set: labelled limb curves in\n"
+               "features.jsonl and, with --ply, hull/NNNNNN_nss.ply (about 0.1-0.3 s a frame-set)",
+               BoolBinding{[](TrackerSettings& t) -> bool& { return t.nss; }, true}});
   s.push_back(
       {"remove_shadows", "--keep-shadows", "skip the edge-based shadow removal",
        BoolBinding{[](TrackerSettings& t) -> bool& { return t.frontend.remove_shadows; }, false}});

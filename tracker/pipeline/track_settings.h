@@ -54,6 +54,9 @@ struct TrackerSettings {
   // stays null.
   std::filesystem::path motion_labels;
   MotionModelChoice motion_model = MotionModelChoice::kLdcrf;
+  // NSS skeletons (thesis 4.4.1) of the voxel hull every frame-set: limb
+  // curves in features.jsonl (`nss`) and, with --ply, hull/NNNNNN_nss.ply.
+  bool nss = false;
 };
 
 // The binding kinds. `ref` gives the setting's field in a TrackerSettings.
