@@ -14,6 +14,7 @@
 #include "common/cancel.h"
 #include "common/error.h"
 #include "sim/camera/rig.h"
+#include "tracker/pose/body_calibration.h"
 #include "tracker/pose/hull_legs.h"
 #include "tracker/pose/icp.h"
 #include "tracker/pose/particle_filter.h"
@@ -272,6 +273,79 @@ TEST(PoseTracker, ThickensTheArmsToTheAxisPointsDiameters) {
   empty.placement.reset();
   EXPECT_FALSE(tracker.Step(empty, 1.0 / 30).tracking);
   EXPECT_NEAR(track(tracker, [&](int, int) { return 1.1 * reference; }).shape.arm_thickness, 1.1, 1e-9);
+}
+
+// Thesis 6.1.1's per-user proportion: the shoulder width is measured where
+// the arms held straight forward cross the line through the model's
+// shoulders. A narrow-shouldered and a broad-shouldered user of the same
+// height are each configured within 1 cm of their own after standing at rest
+// (the arms' axis points lost against the body) and then pointing forward;
+// arms held out sideways (no crossing) measure nothing, and the fixed
+// proportion stays.
+TEST(PoseTracker, ConfiguresTheShoulderWidthFromStraightArms) {
+  const std::vector<Camera> cams = PinholeRig();
+  for (const double width : {0.9, 1.14}) {
+    for (const bool sideways : {false, true}) {
+      const BodyShape shape = BodyShape::FromHeight(1.75, 1.0, 1.0, width);
+      const double yaw = 0.3;
+      const BodyPose rest = StandingPose(shape, Vector2d(0.1, 0.2), yaw);
+      BodyPose held = sideways ? ScarecrowPose(shape, Vector2d(0.1, 0.2), yaw) : rest;
+      if (!sideways) {
+        const Vector2d f = FacingDirection(yaw);
+        const Vector3d forward = Vector3d(f.x(), f.y(), -0.2).normalized();
+        SetArmDirections(shape, &held, kRightUpperArm, forward, forward);
+        SetArmDirections(shape, &held, kLeftUpperArm, forward, forward);
+      }
+      PoseTrackerOptions options;
+      options.seed = 4;
+      PoseTracker tracker(cams, {}, options);
+      PoseEstimate e;
+      for (int f = 0; f < 50; ++f) {
+        // At rest the arms' axis points are lost against the body, as a
+        // real front end loses them.
+        const bool at_rest = f < 20;
+        e = tracker.Step(ModelFeatures(cams, shape, at_rest ? rest : held, f, {!at_rest, !at_rest}), 1.0 / 30);
+        ASSERT_TRUE(e.tracking) << f;
+        if (at_rest) EXPECT_EQ(e.shape.shoulder_width, 1.0) << "no arm points, no measurement";
+      }
+      const double expected = sideways ? 0.105 * e.shape.height_m : shape.shoulder_offset_m;
+      EXPECT_NEAR(2 * e.shape.shoulder_offset_m, 2 * expected, 0.01) << width << (sideways ? " sideways" : "");
+      if (!sideways) {
+        const PosedBody body = PoseBody(shape, held);
+        EXPECT_LT((e.body.joints[kModelRightShoulder] - body.joints[kModelRightShoulder]).norm(), 0.03) << width;
+        EXPECT_LT((e.body.joints[kModelLeftShoulder] - body.joints[kModelLeftShoulder]).norm(), 0.03) << width;
+      }
+    }
+  }
+}
+
+// One arm's crossing with the shoulders' line, against the geometry: a
+// straight arm from a shoulder 0.2 m right of the centre gives 0.2; a bent
+// one, one held sideways, one too short or one passing far from the
+// shoulders' line gives nothing.
+TEST(PoseTracker, ShoulderOffsetFromArmIsWhereAStraightArmCrossesTheShoulders) {
+  const Vector3d centre(0.1, 0.2, 1.4), lateral = Vector3d(1, 1, 0).normalized();
+  const Vector3d forward = Vector3d(-1, 1, 0).normalized(), up(0, 0, 1);
+  const Vector3d shoulder = centre + 0.2 * lateral;
+  auto arm = [](const Vector3d& from, const Vector3d& dir, double length) {
+    std::vector<Vector3d> points;
+    for (double t = 0.02; t <= length; t += 0.04) points.push_back(from + t * dir);
+    return points;
+  };
+  const Vector3d model_shoulder = centre + 0.18 * lateral;  // the model's, 2 cm off
+  auto offset = [&](const std::vector<Vector3d>& points, bool left = false) {
+    return ShoulderOffsetFromArm(points, model_shoulder, centre, lateral, left);
+  };
+  ASSERT_TRUE(offset(arm(shoulder, forward, 0.7)));
+  EXPECT_NEAR(*offset(arm(shoulder, forward, 0.7)), 0.2, 1e-9);
+  EXPECT_NEAR(*offset(arm(shoulder, (forward + up).normalized(), 0.7)), 0.2, 1e-9);
+  EXPECT_NEAR(*offset(arm(shoulder, forward, 0.7), true), -0.2, 1e-9);
+  EXPECT_FALSE(offset(arm(shoulder, lateral, 0.7)));                           // held sideways
+  EXPECT_FALSE(offset(arm(shoulder, forward, 0.4)));                           // too short
+  EXPECT_FALSE(offset(arm(shoulder + Vector3d(0, 0, 0.1), forward, 0.7)));     // 10 cm above the line
+  std::vector<Vector3d> bent = arm(shoulder, forward, 0.3);
+  for (const Vector3d& p : arm(shoulder + 0.3 * forward, up, 0.4)) bent.push_back(p);
+  EXPECT_FALSE(offset(bent));
 }
 
 TEST(PoseTracker, ArmThicknessOptionsAreChecked) {

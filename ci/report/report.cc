@@ -249,7 +249,8 @@ std::string Describe(const fs::path& sequence) {
 }
 
 // The irbench tracker's model for a track line: its 21 `dof` by name,
-// `height_m`, `girth` and `arm_thickness` (1 where a line lacks them).
+// `height_m`, `girth`, `arm_thickness` and `shoulder_width_m` (the fixed
+// proportions where a line lacks them).
 // nullopt for another tracker's line (no dof).
 std::optional<PosedBody> TrackedModel(const Json& line) {
   if (!line.contains("dof") || !line["dof"].is_object() || !line.contains("height_m") ||
@@ -265,8 +266,14 @@ std::optional<PosedBody> TrackedModel(const Json& line) {
   auto number_or_one = [&](const char* key) {
     return line.contains(key) && line[key].is_number() ? line[key].get<double>() : 1.0;
   };
-  return PoseBody(BodyShape::FromHeight(line["height_m"].get<double>(), number_or_one("girth"),
-                                        number_or_one("arm_thickness")),
+  // The configured shoulder width (metres between the joints) as the
+  // model's factor on its fixed proportion.
+  const double height = line["height_m"].get<double>();
+  const double fixed_width = 2 * BodyShape::FromHeight(height).shoulder_offset_m;
+  const double shoulders = line.contains("shoulder_width_m") && line["shoulder_width_m"].is_number() && fixed_width > 0
+                               ? line["shoulder_width_m"].get<double>() / fixed_width
+                               : 1.0;
+  return PoseBody(BodyShape::FromHeight(height, number_or_one("girth"), number_or_one("arm_thickness"), shoulders),
                   pose);
 }
 

@@ -32,6 +32,10 @@ namespace irbench {
 namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
+
+// The track's configured shoulder width (metres): wider than the fixed
+// proportion's 0.3675 m at 1.75 m.
+constexpr double kShoulderWidthM = 0.42;
 using irbench::testing::ReadText;
 
 class ReportTest : public ::testing::Test {
@@ -62,6 +66,7 @@ class ReportTest : public ::testing::Test {
         for (int d = 0; d < kDofCount; ++d) j["dof"][BodyDofName(d)] = pose.dof[d];
         j["height_m"] = 1.75;
         j["girth"] = 1.0;
+        j["shoulder_width_m"] = kShoulderWidthM;
       }
       track << j.dump() << "\n";
     }
@@ -130,6 +135,9 @@ TEST_F(ReportTest, TablesPlotsAndViewerDataSayWhatTheTruthSays) {
   ASSERT_EQ(data["cameras"].size(), input.cameras().size());
   const std::vector<std::string> names = data["joints"];
   int compared = 0;
+  // Pixels between the drawn upper arms' outlines' means and their centres
+  // projected, for the configured and the fixed shoulders.
+  double fixed_apart = 0, configured_apart = 0;
   for (const Json& t : truth_) {
     const int f = t["frame"];
     const Json& fr = data["frames"][f];
@@ -152,19 +160,33 @@ TEST_F(ReportTest, TablesPlotsAndViewerDataSayWhatTheTruthSays) {
         continue;
       }
       ASSERT_EQ(fr["m"][c].size(), 7u) << cam.name;  // seven ellipsoids
-      // The head's outline (segment 2) surrounds the head centre's projection.
-      const BodyShape shape = BodyShape::FromHeight(1.75);
-      const PosedBody body = PoseBody(
-          shape, StandingPose(shape, {t["joints3d"]["root"][0].get<double>(), t["joints3d"]["root"][1].get<double>()}, 0));
-      const Eigen::Vector2d head = cam.Project(body.segments[kHeadSegment].center);
-      const Json& outline = fr["m"][c][kHeadSegment];
-      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-      for (size_t i = 0; i < outline.size(); i += 2) mean += Eigen::Vector2d(outline[i], outline[i + 1]);
-      mean /= double(outline.size() / 2);
-      EXPECT_LT((mean - head).norm(), 1.5) << cam.name;
+      // The head's outline (segment 2) and the upper arms' surround their
+      // centres' projections, the arms hanging from the configured
+      // shoulders (the track's shoulder_width_m).
+      const BodyShape fixed = BodyShape::FromHeight(1.75);
+      const BodyShape shape =
+          BodyShape::FromHeight(1.75, 1.0, 1.0, kShoulderWidthM / (2 * fixed.shoulder_offset_m));
+      const BodyPose pose =
+          StandingPose(fixed, {t["joints3d"]["root"][0].get<double>(), t["joints3d"]["root"][1].get<double>()}, 0);
+      const PosedBody body = PoseBody(fixed, pose), configured = PoseBody(shape, pose);
+      for (const int seg : {int(kHeadSegment), int(kRightUpperArm), int(kLeftUpperArm)}) {
+        const Eigen::Vector2d centre = cam.Project(configured.segments[seg].center);
+        const Json& outline = fr["m"][c][seg];
+        Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+        for (size_t i = 0; i < outline.size(); i += 2) mean += Eigen::Vector2d(outline[i], outline[i + 1]);
+        mean /= double(outline.size() / 2);
+        EXPECT_LT((mean - centre).norm(), 1.5) << cam.name << " " << BodySegmentName(seg);
+        if (seg != kHeadSegment) {
+          fixed_apart = std::max(fixed_apart, (mean - cam.Project(body.segments[seg].center)).norm());
+          configured_apart = std::max(configured_apart, (mean - centre).norm());
+        }
+      }
     }
   }
   EXPECT_GT(compared, 100);
+  // The fixed proportion's arms would have been drawn elsewhere.
+  EXPECT_LT(configured_apart, 0.6);
+  EXPECT_GT(fixed_apart, 1.5);
   // Worst frames first: the largest mean joint error leads.
   ASSERT_FALSE(data["worst"].empty());
   double worst = -1;

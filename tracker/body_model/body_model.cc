@@ -82,11 +82,12 @@ const char* ModelJointName(int joint) {
   return joint >= 0 && joint < kModelJointCount ? names[joint] : "?";
 }
 
-BodyShape BodyShape::FromHeight(double h, double girth, double arm_thickness) {
+BodyShape BodyShape::FromHeight(double h, double girth, double arm_thickness, double shoulder_width) {
   BodyShape s;
   s.height_m = h;
   s.girth = girth;
   s.arm_thickness = arm_thickness;
+  s.shoulder_width = shoulder_width;
   s.waist_height_m = 0.600 * h;
   s.torso_length_m = 0.218 * h;
   // Half of Drillis and Contini's shoulder width (0.259), less the deltoid
@@ -94,7 +95,7 @@ BodyShape BodyShape::FromHeight(double h, double girth, double arm_thickness) {
   // at 0.105 too (times a person's shoulder_width, 0.92-1.12). At 0.100
   // the tracked shoulders sat 1.5-3 cm inside the truth's on p1, p3 and p5
   // (five demos, seeds 1-7: p5's shoulders 5.3 and 5.6 cm -> 4.3, 4.8).
-  s.shoulder_offset_m = 0.105 * h;
+  s.shoulder_offset_m = 0.105 * h * shoulder_width;
   s.spine_depth_m = 0.008 * h;
   s.ankle_setback_m = 0.010 * h;
   s.shoulder_height_m = 0.210 * h;

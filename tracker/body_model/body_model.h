@@ -69,11 +69,14 @@ const char* BodyDofName(int dof);
 // torso's and legs' ellipsoids (and the arms' by its square root): the
 // thesis notes height scaling alone fails "users who are too thin or obese".
 // `arm_thickness` widens the arms' ellipsoids further: sleeves (a jacket)
-// make arms thicker than a torso's girth says.
+// make arms thicker than a torso's girth says. `shoulder_width` scales the
+// shoulder joints' distance from the midline (thesis 6.1.1's per-user
+// proportion, measured by BodyCalibration).
 struct BodyShape {
   double height_m = 1.75;
   double girth = 1.0;
   double arm_thickness = 1.0;
+  double shoulder_width = 1.0;
   double waist_height_m = 0;     // waist joint above the floor, standing
   double torso_length_m = 0;     // waist joint to neck joint
   double shoulder_offset_m = 0;  // shoulder joint from the body's midline (x)
@@ -97,7 +100,8 @@ struct BodyShape {
   // hanging below it).
   std::array<double, kSegmentCount> center_along;
 
-  static BodyShape FromHeight(double height_m, double girth = 1.0, double arm_thickness = 1.0);
+  static BodyShape FromHeight(double height_m, double girth = 1.0, double arm_thickness = 1.0,
+                              double shoulder_width = 1.0);
 };
 
 struct BodyPose {

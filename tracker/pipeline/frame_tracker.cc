@@ -131,6 +131,11 @@ nlohmann::json TrackLine(int f, double t, const FrameFeatures& features, const s
     track_line["height_m"] = std::round(pose->shape.height_m * 1e3) / 1e3;
     track_line["girth"] = std::round(pose->shape.girth * 1e3) / 1e3;
     track_line["arm_thickness"] = std::round(pose->shape.arm_thickness * 1e3) / 1e3;
+    // The configured model's proportions (thesis 6.1.1), as irbench avatar
+    // info gives an avatar's: between joint centres.
+    track_line["shoulder_width_m"] = std::round(2 * pose->shape.shoulder_offset_m * 1e3) / 1e3;
+    track_line["upper_arm_m"] = std::round(pose->shape.upper_arm_m * 1e3) / 1e3;
+    track_line["forearm_m"] = std::round(pose->shape.forearm_m * 1e3) / 1e3;
     nlohmann::json overlap = nlohmann::json::object();
     for (size_t c = 0; c < pose->overlap.size(); ++c) {
       overlap[cameras[c].name] =

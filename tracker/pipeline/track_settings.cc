@@ -110,6 +110,10 @@ std::vector<TrackSetting> MakeSettings() {
   s.push_back({"heading_from_feet", "--heading-from-screen",
                "pose: a standing user is taken to face the screens, not the way the hull's feet point",
                BoolBinding{[](TrackerSettings& t) -> bool& { return t.pose.heading_from_feet; }, false}});
+  s.push_back({"configure_shoulders", "--fixed-shoulders",
+               "pose: keep the model's shoulder width a fixed proportion of the height instead of\n"
+               "measuring it from straight arms held away from the body (thesis 6.1.1)",
+               BoolBinding{[](TrackerSettings& t) -> bool& { return t.pose.configure_shoulders; }, false}});
   s.push_back({"nss", "--nss",
                "NSS skeletons (thesis 4.4.1) of the voxel hull every frame-set: labelled limb curves in\n"
                "features.jsonl and, with --ply, hull/NNNNNN_nss.ply (about 0.1-0.3 s a frame-set)",

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 #include "tracker/pose/internal/median.h"
 
 namespace irbench {
@@ -15,6 +17,8 @@ using pose_internal::Median;
 BodyShape BodyCalibration::Start(double top_m) {
   heights_.clear();
   girths_.clear();
+  shoulder_offsets_.clear();
+  shoulder_width_ = 1.0;
   arm_diameters_.clear();
   arm_frames_ = 0;
   arm_diameter_m_ = 0;
@@ -101,13 +105,83 @@ void BodyCalibration::MeasureArmThickness(bool tracking,
   }
 }
 
+std::optional<double> ShoulderOffsetFromArm(const std::vector<Eigen::Vector3d>& points,
+                                            const Eigen::Vector3d& shoulder, const Eigen::Vector3d& centre,
+                                            const Eigen::Vector3d& lateral, bool left) {
+  std::vector<Eigen::Vector3d> out;  // the points apart from the body
+  for (const Eigen::Vector3d& p : points) {
+    if ((p - shoulder).norm() > 0.15) out.push_back(p);
+  }
+  if (out.size() < 5) return std::nullopt;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : out) mean += p;
+  mean /= double(out.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : out) scatter += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  const Eigen::Vector3d along = eigen.eigenvectors().col(2);
+  // Straight: the two smaller spreads are the points' squared distances from the line.
+  if (std::sqrt(std::max(0.0, eigen.eigenvalues()(0) + eigen.eigenvalues()(1)) / double(out.size())) > 0.02) {
+    return std::nullopt;
+  }
+  const double c = along.dot(lateral);
+  if (std::abs(c) > std::cos(45 * M_PI / 180)) return std::nullopt;
+  // The closest points of the arm's line mean + a along and the shoulders'
+  // line centre + b lateral.
+  const Eigen::Vector3d w = mean - centre;
+  const double a = (c * lateral.dot(w) - along.dot(w)) / (1 - c * c);
+  const double b = (lateral.dot(w) - c * along.dot(w)) / (1 - c * c);
+  const Eigen::Vector3d joint = centre + b * lateral;
+  if ((mean + a * along - joint).norm() > 0.05) return std::nullopt;
+  double reach = 0;
+  for (const Eigen::Vector3d& p : out) reach = std::max(reach, (p - joint).norm());
+  if (reach < 0.45) return std::nullopt;
+  return left ? -b : b;
+}
+
+void BodyCalibration::MeasureShoulderWidth(bool tracking, const PosedBody& body,
+                                           const std::array<std::vector<Eigen::Vector3d>, 2>& arm_points,
+                                           BodyShape* shape) {
+  if (!tracking || static_cast<int>(shoulder_offsets_.size()) >= options_.shoulder_samples) return;
+  const Eigen::Vector3d right = body.joints[kModelRightShoulder], left = body.joints[kModelLeftShoulder];
+  if ((right - left).norm() < 0.1) return;
+  const Eigen::Vector3d centre = 0.5 * (right + left), lateral = (right - left).normalized();
+  // The fixed proportion's offset: a crossing more than 6 cm from it (a
+  // person's shoulders are 0.92-1.12 of it) is a bent arm's forearm line.
+  const double expected = BodyShape::FromHeight(shape->height_m).shoulder_offset_m;
+  bool measured = false;
+  for (const bool is_left : {false, true}) {
+    const std::optional<double> offset =
+        ShoulderOffsetFromArm(arm_points[is_left ? 1 : 0], is_left ? left : right, centre, lateral, is_left);
+    if (offset && std::abs(*offset - expected) < 0.06 &&
+        static_cast<int>(shoulder_offsets_.size()) < options_.shoulder_samples) {
+      shoulder_offsets_.push_back(*offset);
+      measured = true;
+    }
+  }
+  if (measured && static_cast<int>(shoulder_offsets_.size()) >= options_.shoulder_min_samples) {
+    // Confident when the measurements agree (docs/tracker.md): the thick
+    // arms of heavy persons give scattered crossings, whose median can be
+    // 2-4 cm off where the fixed proportion is nearer.
+    std::vector<double> sorted = shoulder_offsets_;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t n = sorted.size();
+    const double spread = sorted[(3 * n) / 4] - sorted[n / 4];
+    const double width = spread <= options_.shoulder_max_spread_m ? Median(shoulder_offsets_) / expected : 1.0;
+    if (width != shoulder_width_) {
+      shoulder_width_ = width;
+      *shape = ShapeFor(shape->height_m, shape->girth);
+    }
+  }
+}
+
 BodyShape BodyCalibration::ShapeFor(double height_m, double girth) const {
   const double thickness =
       arm_diameter_m_ > 0
           ? std::clamp(arm_diameter_m_ / (options_.arm_reference_diameter * height_m), 1.0,
                        options_.max_arm_thickness)
           : 1.0;
-  return BodyShape::FromHeight(height_m, girth, thickness);
+  return BodyShape::FromHeight(height_m, girth, thickness, shoulder_width_);
 }
 
 }  // namespace irbench

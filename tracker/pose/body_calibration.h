@@ -11,6 +11,8 @@
 // The shape is the tracker's (PoseTracker keeps it); these functions update
 // it and say by what ratio the particles' waist heights must scale.
 
+#include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -19,6 +21,19 @@
 #include "tracker/pose/pose_tracker_options.h"
 
 namespace irbench {
+
+// One arm's measurement for MeasureShoulderWidth: the distance (metres) from
+// the midpoint `centre` of the model's shoulders, along the unit `lateral`
+// direction from its left shoulder to its right (negated for the left arm),
+// at which the arm's axis points `points` (metres from the model's shoulder
+// `shoulder`) cross the shoulders' line; nullopt unless the arm is seen held
+// straight and away from the body: at least 5 points beyond 15 cm of the
+// shoulder, reaching 45 cm from where they cross it, within 2 cm (rms) of
+// one line, which passes within 5 cm of the shoulders' line and at least 45
+// degrees from it (an arm held out sideways gives no crossing).
+std::optional<double> ShoulderOffsetFromArm(const std::vector<Eigen::Vector3d>& points,
+                                            const Eigen::Vector3d& shoulder, const Eigen::Vector3d& centre,
+                                            const Eigen::Vector3d& lateral, bool left);
 
 class BodyCalibration {
  public:
@@ -61,12 +76,25 @@ class BodyCalibration {
                            const std::vector<double>& arm_diameters_m,
                            BodyShape* shape);
 
-  // The model for a height (metres) and girth, its arms as thick as measured.
+  // Thesis 6.1.1's per-user proportion, the shoulder width, from this
+  // frame's 3D arm axis points by side (right, left; ArmPointsBySide) while
+  // `tracking` with the estimate `body`: an arm held straight and away from
+  // the body is a line of axis points through its shoulder joint, which
+  // meets the line through the model's shoulders where that joint is
+  // (ShoulderOffsetFromArm). `shape` takes the median of the first
+  // shoulder_samples such measurements once shoulder_min_samples are in.
+  void MeasureShoulderWidth(bool tracking, const PosedBody& body,
+                            const std::array<std::vector<Eigen::Vector3d>, 2>& arm_points, BodyShape* shape);
+
+  // The model for a height (metres) and girth, its arms as thick and its
+  // shoulders as wide as measured.
   BodyShape ShapeFor(double height_m, double girth) const;
 
  private:
   PoseTrackerOptions options_;
   std::vector<double> heights_, girths_;
+  std::vector<double> shoulder_offsets_;  // metres from the midline, per measurement
+  double shoulder_width_ = 1.0;           // their median over the fixed proportion; 1 until measured
   std::vector<double> arm_diameters_;  // metres, from the 3D arm axis points
   int arm_frames_ = 0;                 // tracked frames that gave them
   double arm_diameter_m_ = 0;          // their median; 0 until measured

@@ -322,6 +322,15 @@ void PoseTracker::Calibrate(const FrameFeatures& features, const std::vector<Sil
   }
   // Arm thickness (BodyCalibration::MeasureArmThickness).
   calibration_.MeasureArmThickness(out->tracking, arm_diameters, &shape_);
+  // Shoulder width (thesis 6.1.1; BodyCalibration::MeasureShoulderWidth).
+  if (out->tracking && options_.configure_shoulders && options_.shoulder_samples > 0 && arm_chains_.count > 0) {
+    const PosedBody body = PoseBody(shape_, out->pose);
+    calibration_.MeasureShoulderWidth(
+        out->tracking, body,
+        ArmPointsBySide(arm_chains_.points, arm_chains_.chain, arm_chains_.count,
+                        body.joints[kModelRightShoulder], body.joints[kModelLeftShoulder]),
+        &shape_);
+  }
 }
 
 bool PoseTracker::RestVote(const std::vector<std::optional<PosedBody>>& voters, const std::vector<double>& vote_weight,

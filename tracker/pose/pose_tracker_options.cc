@@ -59,6 +59,10 @@ void PoseTrackerOptions::Check() const {
     throw InputError("", "pose.arm_reference_diameter", "must be positive");
   if (!(max_arm_thickness >= 1))
     throw InputError("", "pose.max_arm_thickness", "must be at least 1");
+  if (shoulder_samples < 0) throw InputError("", "pose.shoulder_samples", "must be non-negative");
+  if (shoulder_min_samples < 1) throw InputError("", "pose.shoulder_min_samples", "must be at least 1");
+  if (!(shoulder_max_spread_m > 0))
+    throw InputError("", "pose.shoulder_max_spread_m", "must be positive");
   if (!(walk_memory_s >= 0)) throw InputError("", "pose.walk_memory_s", "must be non-negative");
 }
 

@@ -133,6 +133,17 @@ struct PoseTrackerOptions {
   int arm_thickness_min_points = 300;
   double arm_reference_diameter = 0.055;
   double max_arm_thickness = 1.3;
+  // Shoulder width (BodyShape::shoulder_width, thesis 6.1.1) from straight
+  // arms held away from the body (BodyCalibration::MeasureShoulderWidth):
+  // the median of the first shoulder_samples arm-frames' measurements (0
+  // turns it off), once shoulder_min_samples are in and their interquartile
+  // range (metres, each shoulder's distance from the midline) is at most
+  // shoulder_max_spread_m; the fixed proportion otherwise.
+  // false: the fixed proportion always (irbench track --fixed-shoulders).
+  bool configure_shoulders = true;
+  int shoulder_samples = 240;
+  int shoulder_min_samples = 40;
+  double shoulder_max_spread_m = 0.03;
   void Check() const;  // throws InputError naming the field
 };
 
