@@ -8,6 +8,7 @@
 # tells how to fuzz longer.
 #
 # Environment:
+#   SANITIZE_STEPS="build tests fuzz"  which steps, in this order
 #   FUZZ_SECONDS=60     seconds per fuzzer (0: build them, fuzz nothing)
 #   FUZZ_PARALLEL=2     fuzzers at a time (default: the core count, at most 2)
 #   FUZZ_TARGETS="bvh rig"  only these fuzzers (default: all)
@@ -140,7 +141,13 @@ run_fuzzers() {
   fi
 }
 
-configure_and_build
-run_unit_tests
-run_fuzzers
+read -r -a STEPS <<<"${SANITIZE_STEPS:-build tests fuzz}"
+for s in "${STEPS[@]}"; do
+  case "$s" in
+    build) configure_and_build ;;
+    tests) run_unit_tests ;;
+    fuzz) run_fuzzers ;;
+    *) echo "sanitize: SANITIZE_STEPS: unknown step '$s' (build, tests, fuzz)" >&2; exit 2 ;;
+  esac
+done
 step "done"
