@@ -136,9 +136,14 @@ Command AddBenchRender(CLI::App* bench_cmd) {
       ->capture_default_str()
       ->transform(IntegerIn(1, 100000));
   cmd->add_option_function<std::string>(
-         "--static-cache", [args](const std::string& v) { args->render.static_cache = v == "on"; },
-         "the static scene drawn once per camera and reused (the same pixels): on (default) or off, to compare")
-      ->check(CLI::IsMember({"on", "off"}));
+         "--static-cache",
+         [args](const std::string& v) {
+           args->render.static_cache = v != "off";
+           if (v == "on") args->render.static_cache_min_pixels = 0;
+         },
+         "the static scene drawn once per camera and reused (the same pixels): auto (default: from\n"
+         "640x480 render pixels), on or off, to compare")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   return {cmd, [args] { return RunBenchRender(*args); }};
 }
 

@@ -117,6 +117,9 @@ Renderer::Renderer(GlContext& context, std::vector<Camera> cameras, const Render
 
   const int s = options_.supersample;
   for (const Camera& cam : cameras_) {
+    if (double(cam.width) * cam.height * s * s < options_.static_cache_min_pixels) options_.static_cache = false;
+  }
+  for (const Camera& cam : cameras_) {
     auto target = std::make_unique<Target>();
     // Extent of the undistorted image of the output border, in output pixels.
     double u_min = 1e9, u_max = -1e9, v_min = 1e9, v_max = -1e9;

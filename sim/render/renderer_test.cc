@@ -224,6 +224,7 @@ TEST(StaticCacheTest, SamePixelsAsDrawingEverythingEveryFrame) {
   const Scene scene = LoadScene(std::string(IRBENCH_SOURCE_DIR) + "/scenes/theater.json");
   RenderOptions cached_options;
   cached_options.shadows = true;
+  cached_options.static_cache_min_pixels = 0;  // the cache at any size
   RenderOptions full_options = cached_options;
   full_options.static_cache = false;
   Renderer cached(*context, rig.cameras, cached_options), full(*context, rig.cameras, full_options);

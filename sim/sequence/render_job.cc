@@ -113,6 +113,7 @@ RenderOptions RenderOptionsFor(const RenderJobOptions& options, const RenderInpu
   render_options.supersample = options.supersample;
   render_options.shadows = options.shadows.value_or(in.models_sensor);
   render_options.static_cache = options.static_cache;
+  render_options.static_cache_min_pixels = options.static_cache_min_pixels;
   return render_options;
 }
 

@@ -50,8 +50,10 @@ struct RenderJobOptions {
   // than clean.
   std::optional<bool> shadows;
   // The static scene drawn once per camera and reused (RenderOptions::
-  // static_cache): the same bytes either way; off only to compare.
+  // static_cache, from static_cache_min_pixels render pixels): the same
+  // bytes either way; off, or on at any size, only to compare.
   bool static_cache = true;
+  int static_cache_min_pixels = 640 * 480;
 };
 
 // The screens' level in empty-stage frame `index` of `count` with the
