@@ -167,7 +167,7 @@ void BodyCalibration::MeasureShoulderWidth(bool tracking, const PosedBody& body,
     std::sort(sorted.begin(), sorted.end());
     const size_t n = sorted.size();
     const double spread = sorted[(3 * n) / 4] - sorted[n / 4];
-    const double width = spread <= options_.shoulder_max_spread_m ? Median(shoulder_offsets_) / expected : 1.0;
+    const double width = spread <= options_.shoulder_max_spread_m ? sorted[n / 2] / expected : 1.0;  // the median
     if (width != shoulder_width_) {
       shoulder_width_ = width;
       *shape = ShapeFor(shape->height_m, shape->girth);

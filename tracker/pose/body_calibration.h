@@ -83,6 +83,8 @@ class BodyCalibration {
   // meets the line through the model's shoulders where that joint is
   // (ShoulderOffsetFromArm). `shape` takes the median of the first
   // shoulder_samples such measurements once shoulder_min_samples are in.
+  // Does MeasureShoulderWidth still take measurements?
+  bool measuring_shoulders() const { return static_cast<int>(shoulder_offsets_.size()) < options_.shoulder_samples; }
   void MeasureShoulderWidth(bool tracking, const PosedBody& body,
                             const std::array<std::vector<Eigen::Vector3d>, 2>& arm_points, BodyShape* shape);
 

@@ -323,7 +323,8 @@ void PoseTracker::Calibrate(const FrameFeatures& features, const std::vector<Sil
   // Arm thickness (BodyCalibration::MeasureArmThickness).
   calibration_.MeasureArmThickness(out->tracking, arm_diameters, &shape_);
   // Shoulder width (thesis 6.1.1; BodyCalibration::MeasureShoulderWidth).
-  if (out->tracking && options_.configure_shoulders && options_.shoulder_samples > 0 && arm_chains_.count > 0) {
+  // Once its samples are in, the arms' points are not split by side for it.
+  if (out->tracking && options_.configure_shoulders && calibration_.measuring_shoulders() && arm_chains_.count > 0) {
     const PosedBody body = PoseBody(shape_, out->pose);
     calibration_.MeasureShoulderWidth(
         out->tracking, body,
