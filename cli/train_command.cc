@@ -209,7 +209,8 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   CLI::App* gestures_cmd = train_cmd->add_subcommand(
       "gestures",
       "Gesture models (thesis 5.2): HMM, PaHMM and FHMM per gesture over the posture decomposition,\n"
-      "from rendered gesture sessions (irbench render --motion gesture_set) tracked by the tracker;\n"
+      "from rendered gesture sessions (irbench render --motion gesture_set) as the tracker tracked them\n"
+      "(each session's track/ when made with the same posture atoms, else tracked here);\n"
       "with --test or --leave-one-out, the identification rates of Table 5.2");
   gestures_cmd->add_option("--train", gesture_args->train, "rendered gesture sessions to train on")
       ->required()
@@ -226,6 +227,8 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   gestures_cmd->add_option("--seed", gesture_args->job.options.seed, "seed of the EM starts")
       ->capture_default_str()
       ->transform(Uint64Text());
+  gestures_cmd->add_flag("--retrack", gesture_args->job.retrack,
+                         "track every session here even when its track/ was made with these posture atoms");
   gestures_cmd->add_option("--table", gesture_args->table, "also write the tables as Markdown to this file");
   gestures_cmd->add_option("--out", gesture_args->out, "model file (default: tracker/models/gesture_models.json)");
   return {{cmd, [cmd, args] { return RunTrainRest(*cmd, *args); }},

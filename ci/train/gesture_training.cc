@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <sstream>
 
+#include "ci/train/existing_track.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/json_reader.h"
 #include "common/logging.h"
 #include "common/paths.h"
 #include "common/progress.h"
+#include "common/sha256.h"
 #include "sequence_format/manifest.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/frame_tracker.h"
@@ -39,6 +41,7 @@ constexpr double kThesisHmm[6][5] = {{37.5, 50, 76.9, 44, 80.0},  {87.5, 87.5, 1
 // the truth's gesture spans.
 struct TrackedSession {
   std::string person;
+  std::string track;  // where the tracker's output came from
   std::vector<std::optional<GestureObservation>> frames;
   struct Span {
     int gesture, first, last;
@@ -54,10 +57,9 @@ struct TrackedSession {
   }
 };
 
-TrackedSession Track(const fs::path& dir, const fs::path& atoms) {
-  TrackedSession s;
-  const Manifest manifest = ReadManifest(dir);
-  s.person = manifest.avatar.empty() ? dir.filename().string() : manifest.avatar;
+// The truth's gesture spans of a rendered session.
+std::vector<TrackedSession::Span> GestureSpans(const fs::path& dir) {
+  std::vector<TrackedSession::Span> spans;
   const fs::path events_file = dir / "truth" / "events.json";
   const JsonNode events = ParseJsonFile(events_file.string());
   for (size_t i = 0; i < events.Size(); ++i) {
@@ -65,10 +67,57 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms) {
     const std::string name = events[i].GetString("value");
     const auto it = std::find(Gestures().begin(), Gestures().end(), name);
     if (it == Gestures().end()) events[i]["value"].Fail("unknown gesture '" + name + "'");
-    s.spans.push_back({static_cast<int>(it - Gestures().begin()), events[i].GetInt("start_frame"),
-                       events[i].GetInt("end_frame")});
+    spans.push_back({static_cast<int>(it - Gestures().begin()), events[i].GetInt("start_frame"),
+                     events[i].GetInt("end_frame")});
   }
-  if (s.spans.empty()) throw InputError(events_file.string(), "", "no gesture events: not a gesture session");
+  if (spans.empty()) throw InputError(events_file.string(), "", "no gesture events: not a gesture session");
+  return spans;
+}
+
+// A track.jsonl line's posture (weights as track.jsonl rounds them, to 4
+// decimals), or nullopt for none; an atom the line lacks weighs 0.
+std::optional<GestureObservation> PostureOfTrackLine(const nlohmann::json& line, const PostureAtoms& atoms) {
+  if (!line.is_object() || !line.contains("posture") || !line["posture"].is_object()) return std::nullopt;
+  const nlohmann::json& posture = line["posture"];
+  if (!posture.contains("pair") || !posture["pair"].is_array() || posture["pair"].size() != 2 ||
+      !posture.contains("weights") || !posture["weights"].is_object()) {
+    return std::nullopt;
+  }
+  auto index = [&](const nlohmann::json& name) {
+    const auto it = name.is_string() ? std::find(atoms.names.begin(), atoms.names.end(), name.get<std::string>())
+                                     : atoms.names.end();
+    return it == atoms.names.end() ? -1 : static_cast<int>(it - atoms.names.begin());
+  };
+  GestureObservation o;
+  o.secondary = index(posture["pair"][0]);
+  o.primary = index(posture["pair"][1]);
+  if (o.primary < 0 || o.secondary < 0) return std::nullopt;
+  o.weights = Eigen::VectorXd::Zero(static_cast<int>(atoms.names.size()));
+  for (size_t k = 0; k < atoms.names.size(); ++k) {
+    const auto w = posture["weights"].find(atoms.names[k]);
+    if (w != posture["weights"].end() && w->is_number()) o.weights[static_cast<int>(k)] = w->get<double>();
+  }
+  return o;
+}
+
+// The session as the tracker saw it: from its track/ when that was made with
+// these posture atoms (and `retrack` is off), else tracked here.
+TrackedSession Track(const fs::path& dir, const fs::path& atoms, const PostureAtoms& atom_model, bool retrack) {
+  TrackedSession s;
+  const Manifest manifest = ReadManifest(dir);
+  s.person = manifest.avatar.empty() ? dir.filename().string() : manifest.avatar;
+  s.spans = GestureSpans(dir);
+  if (std::optional<ExistingTrack> existing = retrack ? std::nullopt : ReadExistingTrack(dir, manifest.frame_count)) {
+    if (TrackModelSha256(*existing, "posture_atoms") == Sha256OfFile(atoms)) {
+      Log().info("train gestures: {}: using its track/", dir.filename().string());
+      s.track = "track/";
+      for (const nlohmann::json& line : existing->lines) s.frames.push_back(PostureOfTrackLine(line, atom_model));
+      return s;
+    }
+    Log().info("train gestures: {}: its track/ was made with other posture atoms: tracking it again",
+               dir.filename().string());
+  }
+  s.track = "tracked by irbench train gestures";
   const SequenceInput input = SequenceInput::Open(dir);
   TrackerSettings settings;
   settings.posture_atoms = atoms;
@@ -225,11 +274,13 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
   }
   const PostureAtoms atom_model = PostureAtoms::Load(atoms);
   std::vector<TrackedSession> train, test;
-  for (const fs::path& dir : job.train) train.push_back(Track(dir, atoms));
-  for (const fs::path& dir : job.test) test.push_back(Track(dir, atoms));
+  for (const fs::path& dir : job.train) train.push_back(Track(dir, atoms, atom_model, job.retrack));
+  for (const fs::path& dir : job.test) test.push_back(Track(dir, atoms, atom_model, job.retrack));
   std::vector<const TrackedSession*> all;
   for (const auto& s : train) all.push_back(&s);
   GestureTrainingResult result;
+  for (size_t i = 0; i < job.train.size(); ++i) result.tracks[job.train[i].filename().string()] = train[i].track;
+  for (size_t i = 0; i < job.test.size(); ++i) result.tracks[job.test[i].filename().string()] = test[i].track;
   GestureModels models = TrainPresent(atom_model.names, all, job.options);
   for (const auto& per_gesture : SegmentsOf(all)) result.segments += static_cast<int>(per_gesture.size());
   result.evaluation.gestures = models.gestures;
@@ -253,6 +304,11 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
                        {"sequences", [&] {
                           nlohmann::json a = nlohmann::json::array();
                           for (const fs::path& p : job.train) a.push_back(p.filename().string());
+                          return a;
+                        }()},
+                       {"tracks", [&] {
+                          nlohmann::json a = nlohmann::json::object();
+                          for (size_t i = 0; i < job.train.size(); ++i) a[job.train[i].filename().string()] = train[i].track;
                           return a;
                         }()},
                        {"segments", result.segments},

@@ -6,9 +6,13 @@
 // each gesture's model; the most likely is the recognised gesture. Table 5.2
 // is the identification rate per gesture and person.
 //
-// Each sequence is run through the tracker (front end, pose, posture
-// decomposition with the given atoms), so training sees the tracker's
-// postures and errors; the truth gives only the gestures' spans.
+// Training sees each sequence as the tracker saw it (front end, pose,
+// posture decomposition with the given atoms), errors included; the truth
+// gives only the gestures' spans. A sequence's `track/` (what `irbench track
+// SEQ` writes) is used when it is a pose-stage track of all its frames made
+// with the same posture atoms (track.json's models.posture_atoms.sha256); its
+// weights are track.jsonl's, rounded to 4 decimals. Otherwise, or with
+// `retrack`, the tracker runs on the sequence here.
 
 #include <filesystem>
 #include <map>
@@ -28,6 +32,7 @@ struct GestureTrainingJob {
   std::filesystem::path posture_atoms;  // default: DefaultPostureAtomsPath()
   std::filesystem::path out;            // default: DefaultGestureModelsPath()
   std::filesystem::path table;          // when set: the tables as Markdown
+  bool retrack = false;                 // track every sequence even when its track/ will do
   GestureTrainingOptions options;
 };
 
@@ -47,6 +52,8 @@ struct GestureEvaluation {
 struct GestureTrainingResult {
   std::filesystem::path model;
   int segments = 0;
+  // Per sequence (folder name): "track/" or "tracked by irbench train gestures".
+  std::map<std::string, std::string> tracks;
   GestureEvaluation evaluation;  // empty without test sequences or leave_one_out
 };
 

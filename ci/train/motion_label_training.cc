@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "ci/score/score.h"
+#include "ci/train/existing_track.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/logging.h"
@@ -54,24 +55,6 @@ std::vector<std::optional<std::array<std::string, 2>>> TruthLabels(const fs::pat
   return truth;
 }
 
-// The pose-stage track of all `frames` in dir/track, or nullopt.
-std::optional<std::vector<nlohmann::json>> ExistingTrack(const fs::path& dir, int frames) {
-  const fs::path meta = dir / "track" / "track.json", lines = dir / "track" / "track.jsonl";
-  if (!fs::exists(meta) || !fs::exists(lines)) return std::nullopt;
-  try {
-    std::ifstream in(meta);
-    const nlohmann::json j = nlohmann::json::parse(in);
-    if (j.value("stage", "") != "pose" || j.value("frames", -1) != frames) return std::nullopt;
-  } catch (const nlohmann::json::exception&) {
-    return std::nullopt;
-  }
-  std::vector<nlohmann::json> out(frames);
-  for (auto& [f, line] : ReadFrameLines(lines)) {
-    if (f >= 0 && f < frames) out[f] = std::move(line);
-  }
-  return out;
-}
-
 std::vector<nlohmann::json> TrackHere(const fs::path& dir) {
   const SequenceInput input = SequenceInput::Open(dir);
   TrackerSettings settings;
@@ -93,7 +76,10 @@ TrackedLabels Load(const fs::path& dir, const RestClassifier& rest, bool retrack
   s.name = dir.filename().string();
   s.person = manifest.avatar.empty() ? s.name : manifest.avatar;
   s.truth = TruthLabels(dir, manifest.frame_count);
-  std::optional<std::vector<nlohmann::json>> lines = retrack ? std::nullopt : ExistingTrack(dir, manifest.frame_count);
+  std::optional<std::vector<nlohmann::json>> lines;
+  if (std::optional<ExistingTrack> existing = retrack ? std::nullopt : ReadExistingTrack(dir, manifest.frame_count)) {
+    lines = std::move(existing->lines);
+  }
   if (lines) {
     s.track = "track/";
     Log().info("train motion-labels: {}: using its track/", s.name);
