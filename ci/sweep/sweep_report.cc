@@ -42,7 +42,7 @@ std::string Short(double v) {
 std::string CoordinateText(const nlohmann::json& v) {
   if (v.is_string()) return v.get<std::string>();
   if (v.is_number()) return Num(v.get<double>());
-  if (v.is_array() && v.size() == 3) {
+  if (v.is_array() && v.size() == 3 && v[0].is_number() && v[1].is_number() && v[2].is_number()) {
     return "(" + Short(v[0].get<double>()) + ", " + Short(v[1].get<double>()) + ", " + Short(v[2].get<double>()) + ")";
   }
   return v.dump();
@@ -145,6 +145,15 @@ std::vector<std::string> MetricColumns(const std::vector<Done>& points) {
   return out;
 }
 
+// RFC 4180: a field with a comma, quote or line break quoted, its quotes
+// doubled (a list value such as rig.cameras' is JSON text).
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (const char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
 std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const std::vector<std::string>& metrics) {
   std::ostringstream out;
   out << "point";
@@ -169,9 +178,7 @@ std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const st
         out << "," << Num(at.along) << "," << Num(at.height) << "," << Num(at.position.x()) << ","
             << Num(at.position.y()) << "," << Num(at.position.z());
       } else {
-        std::string v = CoordinateText(at.value);
-        if (v.find_first_of(",\"") != std::string::npos) v = "\"" + v + "\"";  // (no quotes in names)
-        out << "," << v;
+        out << "," << CsvField(CoordinateText(at.value));
       }
     }
     for (const std::string& m : metrics) {

@@ -11,6 +11,7 @@
 #include "common/json_reader.h"
 #include "common/paths.h"
 #include "ci/sweep/sweep_pose.h"
+#include "ci/sweep/sweep_rig.h"
 #include "sequence_format/calibration.h"
 #include "sim/camera/rig.h"
 #include "sim/scene/mesh.h"
@@ -144,6 +145,41 @@ void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& p
                                                 "' " + Vec(place.lo) + " to " + Vec(place.hi));
       }
       if ((at - p.look_at).norm() < 1e-6) a["look_at"].Fail("the camera at " + Vec(at) + " is at its look_at");
+    }
+  }
+}
+
+// The rig axes' values (sweep_rig.h) tried on every rig a point may have.
+void CheckRigAxes(const SweepSpec& spec, const JsonNode& axes, const std::vector<nlohmann::json>& rigs) {
+  size_t value_axis = 0;
+  for (size_t i = 0; i < axes.Size(); ++i) {
+    const JsonNode a = axes[i];
+    if (a.Has("camera") || a.Has("pose")) continue;
+    const ValueAxis& v = std::get<ValueAxis>(spec.axes[value_axis++].axis);
+    if (!IsRigAxisKey(v.key)) continue;
+    for (const nlohmann::json& rig : rigs) {
+      const fs::path rig_file = PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), spec.file)).rig_file;
+      for (size_t j = 0; j < v.values.size(); ++j) {
+        if (const std::string problem = RigAxisProblem(rig_file, v.key, v.values[j]); !problem.empty()) {
+          a["values"][j].Fail(problem);
+        }
+      }
+    }
+  }
+}
+
+// A placed camera must be among every `rig.cameras` value's.
+void CheckPlacedCameraKept(const SweepSpec& spec, const JsonNode& a, const std::string& camera, const fs::path& rig_file) {
+  for (const SweepAxis& axis : spec.axes) {
+    const auto* v = std::get_if<ValueAxis>(&axis.axis);
+    if (!v || v->key != "rig.cameras") continue;
+    for (const nlohmann::json& value : v->values) {
+      std::ifstream in(rig_file);
+      nlohmann::json rig = nlohmann::json::parse(in);
+      ApplyRigAxis(v->key, value, &rig);
+      const bool kept = std::any_of(rig["cameras"].begin(), rig["cameras"].end(),
+                                    [&](const nlohmann::json& c) { return c.value("name", "") == camera; });
+      if (!kept) a["camera"].Fail("camera '" + camera + "' is left out by rig.cameras " + value.dump());
     }
   }
 }
@@ -300,15 +336,16 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
     ValueAxis v;
     v.key = a.GetString("key");
     const bool track_key = v.key.rfind("track.", 0) == 0 && v.key.size() > 6;
-    if (!track_key && std::find(ValueKeys().begin(), ValueKeys().end(), v.key) == ValueKeys().end()) {
+    if (!track_key && !IsRigAxisKey(v.key) && std::find(ValueKeys().begin(), ValueKeys().end(), v.key) == ValueKeys().end()) {
       a["key"].Fail("not a key a sweep can vary (scene, rig, avatar, motion, sensor, seed, frames, "
-                    "background_frames, track.<setting>)");
+                    "background_frames, track.<setting>, rig.cameras, rig.resolution, rig.focal_scale, rig.dist)");
     }
     if (!names.insert(v.key).second) a["key"].Fail("'" + v.key + "' is swept twice");
     const JsonNode values = a["values"];
     if (values.Size() == 0) values.Fail("an empty list");
     for (size_t j = 0; j < values.Size(); ++j) {
       v.values.push_back(values[j].raw());
+      if (IsRigAxisKey(v.key)) continue;  // checked against every rig below
       try {
         for (const fs::path& f : ScenarioInputFiles(ScenarioOf(WithValue(spec.base, v.key, values[j].raw()), file).render)) {
           spec.inputs.push_back(f);
@@ -320,6 +357,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
     if (v.key == "rig") rigs = v.values;
     spec.axes.push_back({v.key, v});
   }
+  CheckRigAxes(spec, axes, rigs);
   std::vector<SweepAxis> placements;
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
@@ -334,7 +372,11 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
     if (!a.Has("camera")) continue;
     PlacementAxis p = ReadPlacement(a, spec.mode == "grid");
     if (!names.insert(p.camera).second) a["camera"].Fail("camera '" + p.camera + "' is placed twice");
-    for (const nlohmann::json& rig : rigs) CheckPlacement(a, p, PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), file)));
+    for (const nlohmann::json& rig : rigs) {
+      const RigPlace place = PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), file));
+      CheckPlacement(a, p, place);
+      CheckPlacedCameraKept(spec, a, p.camera, place.rig_file);
+    }
     placements.push_back({p.camera, p});
   }
   // Placements first in the point order, as written.
@@ -456,7 +498,13 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
   nlohmann::json keys = spec.base;
   bool moved = false;
   for (size_t k = 0; k < spec.axes.size(); ++k) {
-    if (const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis)) keys = WithValue(keys, v->key, point.at[k].value);
+    if (const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis)) {
+      if (IsRigAxisKey(v->key)) {
+        moved = true;
+      } else {
+        keys = WithValue(keys, v->key, point.at[k].value);
+      }
+    }
     moved |= std::holds_alternative<PlacementAxis>(spec.axes[k].axis);
     if (const auto* pose = std::get_if<PoseAxis>(&spec.axes[k].axis)) {
       const fs::path file = fs::absolute(out / "motions" / (PointName(point.index) + ".json"));
@@ -489,6 +537,13 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
         camera["position"] = {at.x(), at.y(), at.z()};
         camera["look_at"] = {p->look_at.x(), p->look_at.y(), p->look_at.z()};
         if (p->has_up) camera["up"] = {p->up.x(), p->up.y(), p->up.z()};
+      }
+    }
+    // Then the rig axes, in RigAxisKeys()'s order.
+    for (const std::string& key : RigAxisKeys()) {
+      for (size_t k = 0; k < spec.axes.size(); ++k) {
+        const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis);
+        if (v && v->key == key) ApplyRigAxis(key, point.at[k].value, &rig);
       }
     }
     fs::create_directories(rigs);

@@ -1,11 +1,13 @@
 #pragma once
 // A sweep spec (irbench.sweep/1, docs/sweeps.md): a base scenario in a
 // suite's terms, axes — camera placements along a wall or ceiling line and
-// over heights, or lists of values for a scenario key (rig, avatar, motion,
-// sensor, seed, frames, track.<setting>) — and a mode: `grid` (every
-// combination), seeded `random` samples, or `search`: the cross-entropy
-// method over the placements, generation by generation, each generation
-// drawn around the best points of the ones before. Points are numbered; a
+// over heights, lists of values for a scenario key (rig, avatar, motion,
+// sensor, seed, frames, track.<setting>) or for the point's rig
+// (rig.cameras, rig.resolution, rig.focal_scale, rig.dist: sweep_rig.h) —
+// and a mode: `grid` (every combination), seeded `random` samples, or
+// `search`: the cross-entropy method over the placements, generation by
+// generation, each generation drawn around the best points of the ones
+// before. Points are numbered; a
 // point's coordinates depend only on the spec, its index and (search) the
 // metrics of the earlier generations' points, so any process (a local worker,
 // a Slurm array task) can run point i alone.

@@ -219,6 +219,50 @@ TEST(SweepSpecTest, PosePointIsAKeyframeMotionHoldingItsAngles) {
 }
 
 // Each bad spec: InputError naming the spec file and the field.
+// The rig axes: each point's rig keeps the cameras its `rig.cameras` value
+// names, in the rig's order; at twice the resolution a world point lands
+// where the base camera's pixel centre lands, scaled ((u + 0.5) 2 - 0.5);
+// a zoom of 0.8 brings it towards the principal point by 0.8; the lens
+// distortion is the value's.
+TEST(SweepSpecTest, RigAxesMakeEachPointsRig) {
+  const SweepSpec spec = LoadSweepSpec(Write("rig_axes.json", R"({"format": "irbench.sweep/1", "name": "r",
+    "base": {"rig": "theater4", "motion": "wave", "frames": 3},
+    "axes": [{"key": "rig.cameras", "values": [["side", "front_left"], 3]},
+             {"key": "rig.resolution", "values": [[320, 240], [640, 480]]},
+             {"key": "rig.focal_scale", "values": [1, 0.8]},
+             {"key": "rig.dist", "values": [[0, 0, 0, 0, 0]]}]})"));
+  ASSERT_EQ(PointCount(spec), 8);
+  const Rig base = LoadRig(fs::path(IRBENCH_SOURCE_DIR) / "rigs" / "theater4.json");
+  Rig undistorted = base;
+  for (Camera& c : undistorted.cameras) c.dist = {0, 0, 0, 0, 0};
+  const Eigen::Vector3d chest(0.1, -0.2, 1.2);
+  for (int i = 0; i < PointCount(spec); ++i) {
+    const SweepPoint p = PointAt(spec, i);
+    const Rig rig = LoadRig(PointScenario(spec, p, Dir()).render.rig);
+    const bool named = p.at[0].value.is_array();
+    ASSERT_EQ(rig.cameras.size(), named ? 2u : 3u) << i;
+    if (named) {
+      EXPECT_EQ(rig.cameras[0].name, "front_left");  // the rig's order
+      EXPECT_EQ(rig.cameras[1].name, "side");
+    }
+    const double scale = p.at[1].value[0].get<int>() / 320.0, zoom = p.at[2].value.get<double>();
+    for (const Camera& c : rig.cameras) {
+      const Camera* b = nullptr;
+      for (const Camera& u : undistorted.cameras) {
+        if (u.name == c.name) b = &u;
+      }
+      ASSERT_NE(b, nullptr) << c.name;
+      EXPECT_EQ(c.width, static_cast<int>(320 * scale));
+      EXPECT_EQ(c.height, static_cast<int>(240 * scale));
+      for (const double k : c.dist) EXPECT_EQ(k, 0.0);
+      const Eigen::Vector2d principal((b->cx + 0.5) * scale - 0.5, (b->cy + 0.5) * scale - 0.5);
+      const Eigen::Vector2d expected = principal + zoom * ((b->Project(chest).array() + 0.5) * scale - 0.5 -
+                                                           principal.array()).matrix();
+      EXPECT_LT((c.Project(chest) - expected).norm(), 1e-6) << i << " " << c.name;
+    }
+  }
+}
+
 TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
   const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
       {"unknown_axis", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
@@ -245,6 +289,23 @@ TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
          "search": {"population": 4, "generations": 2}, "axes": [{"key": "seed", "values": [1]}]})", "axes[0]"},
       {"base_key", R"({"format": "irbench.sweep/1", "name": "b", "base": {"lens": 2},
          "axes": [{"key": "seed", "values": [1]}]})", "base.lens"},
+      {"one_camera", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.cameras", "values": [3, ["front_left"]]}]})", "axes[0].values[1]"},
+      {"unknown_camera", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.cameras", "values": [["front_left", "back"]]}]})", "axes[0].values[0]"},
+      {"too_many_cameras", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.cameras", "values": [5]}]})", "axes[0].values[0]"},
+      {"resolution", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.resolution", "values": [[640, 480], [4, 3]]}]})", "axes[0].values[1]"},
+      {"zoom", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.focal_scale", "values": [0]}]})", "axes[0].values[0]"},
+      {"dist", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.dist", "values": [[0.1, 0.0, 0.0]]}]})", "axes[0].values[0]"},
+      {"dist_folds", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "rig.dist", "values": [[0, 0, 0, 0, 0], [-90, 0, 0, 0, 0]]}]})", "axes[0].values[1]"},
+      {"placed_left_out", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"camera": "side", "along": {"from": [-3, 0], "to": [-3, 1], "steps": 2}, "height": 2},
+                  {"key": "rig.cameras", "values": [["front_left", "front_right"]]}]})", "axes[0].camera"},
   };
   for (const auto& [name, text, field] : cases) {
     const fs::path file = Write(name + ".json", text);

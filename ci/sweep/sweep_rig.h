@@ -1,0 +1,34 @@
+#pragma once
+// A sweep's rig axes (docs/sweeps.md): value axes whose key starts with
+// `rig.` change every point's rig rather than a scenario key:
+//   rig.cameras      which of the rig's cameras are used: a list of names, or
+//                    n for the first n (the camera count); at least 2
+//   rig.resolution   [width, height] of every camera, the intrinsics scaled
+//                    with it (the same field of view and distortion)
+//   rig.focal_scale  every camera's fx and fy times this (a zoom: < 1 wider)
+//   rig.dist         every camera's lens distortion [k1, k2, p1, p2, k3]
+// A point's rig is the base rig (or the `rig` axis's) with the placements
+// applied first, then these in the order above.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace irbench {
+
+const std::vector<std::string>& RigAxisKeys();
+bool IsRigAxisKey(const std::string& key);
+
+// Applies one rig axis's value to a rig file's JSON (irbench.rig/1). Throws
+// InputError (empty file, the field "value") for a value of the wrong shape or
+// a camera the rig lacks; the result is checked by LoadRig, not here.
+void ApplyRigAxis(const std::string& key, const nlohmann::json& value, nlohmann::json* rig);
+
+// The rig file's JSON with `value` applied, loaded and checked as a rig file
+// would be (LoadRig, through a scratch file): "" or what is wrong, e.g.
+// "cameras[1].fx: focal length must be positive".
+std::string RigAxisProblem(const std::filesystem::path& rig_file, const std::string& key, const nlohmann::json& value);
+
+}  // namespace irbench
