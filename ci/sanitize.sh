@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The sanitizer CI configuration (issue 27): clang with AddressSanitizer, UBSan
 # and LeakSanitizer in build-san/. Builds the unit tests (CTest label "unit":
-# the GoogleTest binaries beside each library, not the closed-loop tests in
+# the GoogleTest binaries beside each library, each one CTest test running
+# all its tests in one process; not the closed-loop tests in
 # tests/) and the libFuzzer harnesses (fuzz/), runs the unit tests, then runs
 # every fuzzer on a scratch copy of its seed corpus. Fails on any test failure,
 # sanitizer report, leak, crash or timeout. ci/test.sh calls it; docs/fuzzing.md
