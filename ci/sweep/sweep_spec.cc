@@ -149,19 +149,20 @@ void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& p
   }
 }
 
+// One rig axis: its node in the spec's `axes` and its value axis.
+struct RigAxisAt {
+  JsonNode node;
+  ValueAxis axis;
+};
+
 // The rig axes' values (sweep_rig.h) tried on every rig a point may have.
-void CheckRigAxes(const SweepSpec& spec, const JsonNode& axes, const std::vector<nlohmann::json>& rigs) {
-  size_t value_axis = 0;
-  for (size_t i = 0; i < axes.Size(); ++i) {
-    const JsonNode a = axes[i];
-    if (a.Has("camera") || a.Has("pose")) continue;
-    const ValueAxis& v = std::get<ValueAxis>(spec.axes[value_axis++].axis);
-    if (!IsRigAxisKey(v.key)) continue;
+void CheckRigAxes(const SweepSpec& spec, const std::vector<RigAxisAt>& rig_axes, const std::vector<nlohmann::json>& rigs) {
+  for (const RigAxisAt& at : rig_axes) {
     for (const nlohmann::json& rig : rigs) {
       const fs::path rig_file = PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), spec.file)).rig_file;
-      for (size_t j = 0; j < v.values.size(); ++j) {
-        if (const std::string problem = RigAxisProblem(rig_file, v.key, v.values[j]); !problem.empty()) {
-          a["values"][j].Fail(problem);
+      for (size_t j = 0; j < at.axis.values.size(); ++j) {
+        if (const std::string problem = RigAxisProblem(rig_file, at.axis.key, at.axis.values[j]); !problem.empty()) {
+          at.node["values"][j].Fail(problem);
         }
       }
     }
@@ -169,17 +170,18 @@ void CheckRigAxes(const SweepSpec& spec, const JsonNode& axes, const std::vector
 }
 
 // A placed camera must be among every `rig.cameras` value's.
-void CheckPlacedCameraKept(const SweepSpec& spec, const JsonNode& a, const std::string& camera, const fs::path& rig_file) {
-  for (const SweepAxis& axis : spec.axes) {
-    const auto* v = std::get_if<ValueAxis>(&axis.axis);
-    if (!v || v->key != "rig.cameras") continue;
-    for (const nlohmann::json& value : v->values) {
-      std::ifstream in(rig_file);
-      nlohmann::json rig = nlohmann::json::parse(in);
-      ApplyRigAxis(v->key, value, &rig);
-      const bool kept = std::any_of(rig["cameras"].begin(), rig["cameras"].end(),
-                                    [&](const nlohmann::json& c) { return c.value("name", "") == camera; });
-      if (!kept) a["camera"].Fail("camera '" + camera + "' is left out by rig.cameras " + value.dump());
+void CheckPlacedCameraKept(const std::vector<RigAxisAt>& rig_axes, const JsonNode& a, const std::string& camera,
+                           const Rig& rig) {
+  nlohmann::json names = {{"cameras", nlohmann::json::array()}};
+  for (const Camera& c : rig.cameras) names["cameras"].push_back({{"name", c.name}});
+  for (const RigAxisAt& at : rig_axes) {
+    if (at.axis.key != "rig.cameras") continue;
+    for (const nlohmann::json& value : at.axis.values) {
+      nlohmann::json kept = names;
+      ApplyRigAxis(at.axis.key, value, &kept);
+      const bool found = std::any_of(kept["cameras"].begin(), kept["cameras"].end(),
+                                     [&](const nlohmann::json& c) { return c.value("name", "") == camera; });
+      if (!found) a["camera"].Fail("camera '" + camera + "' is left out by rig.cameras " + value.dump());
     }
   }
 }
@@ -327,6 +329,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
   if (axes.Size() == 0) axes.Fail("no axes");
   std::set<std::string> names;
   std::vector<nlohmann::json> rigs = {spec.base.value("rig", std::string("theater4"))};
+  std::vector<RigAxisAt> rig_axes;
   // Value axes first: a placement is checked against every rig a point may have.
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
@@ -355,9 +358,10 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
       }
     }
     if (v.key == "rig") rigs = v.values;
+    if (IsRigAxisKey(v.key)) rig_axes.push_back({a, v});
     spec.axes.push_back({v.key, v});
   }
-  CheckRigAxes(spec, axes, rigs);
+  CheckRigAxes(spec, rig_axes, rigs);
   std::vector<SweepAxis> placements;
   for (size_t i = 0; i < axes.Size(); ++i) {
     const JsonNode a = axes[i];
@@ -375,7 +379,7 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
     for (const nlohmann::json& rig : rigs) {
       const RigPlace place = PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), file));
       CheckPlacement(a, p, place);
-      CheckPlacedCameraKept(spec, a, p.camera, place.rig_file);
+      CheckPlacedCameraKept(rig_axes, a, p.camera, place.rig);
     }
     placements.push_back({p.camera, p});
   }

@@ -6,7 +6,9 @@
 // tracking a session costs more than training on it.
 
 #include <filesystem>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -18,12 +20,16 @@ struct ExistingTrack {
   std::vector<nlohmann::json> lines;  // track.jsonl by frame; null where a frame has no line
 };
 
-// dir/track when its track.json says stage "pose" and `frames` frames, else
-// nullopt (also for an unreadable track.json: the caller tracks instead).
-std::optional<ExistingTrack> ReadExistingTrack(const std::filesystem::path& dir, int frames);
+// Why ReadExistingTrack gave nothing.
+enum class ExistingTrackMiss { kNone, kOtherModels };
 
-// The sha256 track.json records for one of the models the track was made
-// with (models.<name>.sha256), or "" when it records none.
-std::string TrackModelSha256(const ExistingTrack& track, const std::string& name);
+// dir/track when its track.json says stage "pose" and `frames` frames and
+// records, for each of `models` (name -> sha256), that it was made with that
+// model (models.<name>.sha256), else nullopt: also for an unreadable
+// track.json, and the caller tracks instead. The models are compared before
+// track.jsonl is read; `miss` says whether they were the reason.
+std::optional<ExistingTrack> ReadExistingTrack(const std::filesystem::path& dir, int frames,
+                                               const std::map<std::string, std::string>& models = {},
+                                               ExistingTrackMiss* miss = nullptr);
 
 }  // namespace irbench

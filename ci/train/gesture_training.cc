@@ -101,19 +101,23 @@ std::optional<GestureObservation> PostureOfTrackLine(const nlohmann::json& line,
 }
 
 // The session as the tracker saw it: from its track/ when that was made with
-// these posture atoms (and `retrack` is off), else tracked here.
-TrackedSession Track(const fs::path& dir, const fs::path& atoms, const PostureAtoms& atom_model, bool retrack) {
+// these posture atoms (`atoms_sha256`, and `retrack` is off), else tracked here.
+TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::string& atoms_sha256,
+                     const PostureAtoms& atom_model, bool retrack) {
   TrackedSession s;
   const Manifest manifest = ReadManifest(dir);
   s.person = manifest.avatar.empty() ? dir.filename().string() : manifest.avatar;
   s.spans = GestureSpans(dir);
-  if (std::optional<ExistingTrack> existing = retrack ? std::nullopt : ReadExistingTrack(dir, manifest.frame_count)) {
-    if (TrackModelSha256(*existing, "posture_atoms") == Sha256OfFile(atoms)) {
-      Log().info("train gestures: {}: using its track/", dir.filename().string());
-      s.track = "track/";
-      for (const nlohmann::json& line : existing->lines) s.frames.push_back(PostureOfTrackLine(line, atom_model));
-      return s;
-    }
+  ExistingTrackMiss miss = ExistingTrackMiss::kNone;
+  if (std::optional<ExistingTrack> existing =
+          retrack ? std::nullopt
+                  : ReadExistingTrack(dir, manifest.frame_count, {{"posture_atoms", atoms_sha256}}, &miss)) {
+    Log().info("train gestures: {}: using its track/", dir.filename().string());
+    s.track = "track/";
+    for (const nlohmann::json& line : existing->lines) s.frames.push_back(PostureOfTrackLine(line, atom_model));
+    return s;
+  }
+  if (miss == ExistingTrackMiss::kOtherModels) {
     Log().info("train gestures: {}: its track/ was made with other posture atoms: tracking it again",
                dir.filename().string());
   }
@@ -274,8 +278,9 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
   }
   const PostureAtoms atom_model = PostureAtoms::Load(atoms);
   std::vector<TrackedSession> train, test;
-  for (const fs::path& dir : job.train) train.push_back(Track(dir, atoms, atom_model, job.retrack));
-  for (const fs::path& dir : job.test) test.push_back(Track(dir, atoms, atom_model, job.retrack));
+  const std::string atoms_sha256 = Sha256OfFile(atoms);
+  for (const fs::path& dir : job.train) train.push_back(Track(dir, atoms, atoms_sha256, atom_model, job.retrack));
+  for (const fs::path& dir : job.test) test.push_back(Track(dir, atoms, atoms_sha256, atom_model, job.retrack));
   std::vector<const TrackedSession*> all;
   for (const auto& s : train) all.push_back(&s);
   GestureTrainingResult result;
@@ -308,7 +313,7 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
                         }()},
                        {"tracks", [&] {
                           nlohmann::json a = nlohmann::json::object();
-                          for (size_t i = 0; i < job.train.size(); ++i) a[job.train[i].filename().string()] = train[i].track;
+                          for (const fs::path& p : job.train) a[p.filename().string()] = result.tracks.at(p.filename().string());
                           return a;
                         }()},
                        {"segments", result.segments},
