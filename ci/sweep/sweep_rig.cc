@@ -10,6 +10,7 @@
 
 #include "common/error.h"
 #include "sim/camera/rig.h"
+#include "sim/sensor/sensor_model.h"
 
 namespace irbench {
 
@@ -96,7 +97,25 @@ void Distort(const nlohmann::json& value, nlohmann::json* rig) {
   for (nlohmann::json& c : (*rig)["cameras"]) c["dist"] = value;
 }
 
+// Every camera's override of the knob `sensor.<group>.<knob>` set to the value.
+void SetKnob(const std::string& key, const nlohmann::json& value, nlohmann::json* rig) {
+  if (!value.is_number() && !value.is_boolean()) Bad("a sensor knob takes a number or true/false");
+  const size_t dot = key.find('.', 7);
+  const std::string group = key.substr(7, dot - 7), knob = key.substr(dot + 1);
+  for (nlohmann::json& c : (*rig)["cameras"]) {
+    if (!c.contains("sensor") || !c["sensor"].is_object()) c["sensor"] = nlohmann::json::object();
+    if (!c["sensor"].contains(group) || !c["sensor"][group].is_object()) c["sensor"][group] = nlohmann::json::object();
+    c["sensor"][group][knob] = value;
+  }
+}
+
 }  // namespace
+
+bool IsSensorKnobKey(const std::string& key) {
+  if (key.rfind("sensor.", 0) != 0) return false;
+  const size_t dot = key.find('.', 7);
+  return dot != std::string::npos && dot > 7 && dot + 1 < key.size() && key.find('.', dot + 1) == std::string::npos;
+}
 
 const std::vector<std::string>& RigAxisKeys() {
   static const std::vector<std::string> keys = {"rig.cameras", "rig.resolution", "rig.focal_scale", "rig.dist"};
@@ -104,7 +123,7 @@ const std::vector<std::string>& RigAxisKeys() {
 }
 
 bool IsRigAxisKey(const std::string& key) {
-  return std::find(RigAxisKeys().begin(), RigAxisKeys().end(), key) != RigAxisKeys().end();
+  return std::find(RigAxisKeys().begin(), RigAxisKeys().end(), key) != RigAxisKeys().end() || IsSensorKnobKey(key);
 }
 
 void ApplyRigAxis(const std::string& key, const nlohmann::json& value, nlohmann::json* rig) {
@@ -117,12 +136,15 @@ void ApplyRigAxis(const std::string& key, const nlohmann::json& value, nlohmann:
     Zoom(value, rig);
   } else if (key == "rig.dist") {
     Distort(value, rig);
+  } else if (IsSensorKnobKey(key)) {
+    SetKnob(key, value, rig);
   } else {
     Bad("not a rig axis: " + key);
   }
 }
 
-std::string RigAxisProblem(const fs::path& rig_file, const std::string& key, const nlohmann::json& value) {
+std::string RigAxisProblem(const fs::path& rig_file, const std::string& key, const nlohmann::json& value,
+                           const std::vector<std::string>& presets) {
   nlohmann::json rig;
   try {
     std::ifstream in(rig_file);
@@ -140,7 +162,14 @@ std::string RigAxisProblem(const fs::path& rig_file, const std::string& key, con
   std::ofstream(scratch) << rig.dump(2) << "\n";
   std::string problem;
   try {
-    LoadRig(scratch);
+    const Rig loaded = LoadRig(scratch);
+    for (size_t i = 0; IsSensorKnobKey(key) && i < loaded.cameras.size(); ++i) {
+      for (const std::string& preset : presets) {
+        std::optional<SensorSetup> setup = SensorPreset(preset);
+        if (!setup) continue;  // an unknown preset is the `sensor` key's error
+        ApplySensorOverrides(loaded.sensor_overrides[i], "", "cameras[" + std::to_string(i) + "].sensor", &*setup);
+      }
+    }
   } catch (const InputError& e) {
     problem = "rig " + rig_file.filename().string() + " with it: " + (e.field().empty() ? "" : e.field() + ": ") +
               e.message();

@@ -7,8 +7,13 @@
 //                    with it (the same field of view and distortion)
 //   rig.focal_scale  every camera's fx and fy times this (a zoom: < 1 wider)
 //   rig.dist         every camera's lens distortion [k1, k2, p1, p2, k3]
+// and the sensor knobs, `sensor.<group>.<knob>` (docs/sensor.md's groups
+// sensor, flicker, optics, capture): every camera's sensor override of that
+// knob (the rig's `cameras[i].sensor`) set to the value, on top of the
+// point's preset.
 // A point's rig is the base rig (or the `rig` axis's) with the placements
-// applied first, then these in the order above.
+// applied first, then the rig.* keys in the order above, then the knobs in
+// the spec's order.
 
 #include <filesystem>
 #include <string>
@@ -18,7 +23,11 @@
 
 namespace irbench {
 
+// The rig.* keys, in the order they are applied.
 const std::vector<std::string>& RigAxisKeys();
+// `sensor.<group>.<knob>`, both names non-empty.
+bool IsSensorKnobKey(const std::string& key);
+// A rig.* key or a sensor knob.
 bool IsRigAxisKey(const std::string& key);
 
 // Applies one rig axis's value to a rig file's JSON (irbench.rig/1). Throws
@@ -27,8 +36,11 @@ bool IsRigAxisKey(const std::string& key);
 void ApplyRigAxis(const std::string& key, const nlohmann::json& value, nlohmann::json* rig);
 
 // The rig file's JSON with `value` applied, loaded and checked as a rig file
-// would be (LoadRig, through a scratch file): "" or what is wrong, e.g.
+// would be (LoadRig, through a scratch file) and, for a sensor knob, each
+// camera's sensor overrides applied to each of `presets` (the sensor presets
+// a point may have) as a render would: "" or what is wrong, e.g.
 // "cameras[1].fx: focal length must be positive".
-std::string RigAxisProblem(const std::filesystem::path& rig_file, const std::string& key, const nlohmann::json& value);
+std::string RigAxisProblem(const std::filesystem::path& rig_file, const std::string& key, const nlohmann::json& value,
+                           const std::vector<std::string>& presets);
 
 }  // namespace irbench

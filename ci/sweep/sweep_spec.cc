@@ -157,11 +157,21 @@ struct RigAxisAt {
 
 // The rig axes' values (sweep_rig.h) tried on every rig a point may have.
 void CheckRigAxes(const SweepSpec& spec, const std::vector<RigAxisAt>& rig_axes, const std::vector<nlohmann::json>& rigs) {
+  // The sensor presets a point may have, for the sensor knobs.
+  std::vector<std::string> presets = {spec.base.value("sensor", std::string("thesis"))};
+  for (const SweepAxis& axis : spec.axes) {
+    const auto* v = std::get_if<ValueAxis>(&axis.axis);
+    if (!v || v->key != "sensor") continue;
+    presets.clear();
+    for (const nlohmann::json& value : v->values) {
+      if (value.is_string()) presets.push_back(value.get<std::string>());
+    }
+  }
   for (const RigAxisAt& at : rig_axes) {
     for (const nlohmann::json& rig : rigs) {
       const fs::path rig_file = PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), spec.file)).rig_file;
       for (size_t j = 0; j < at.axis.values.size(); ++j) {
-        if (const std::string problem = RigAxisProblem(rig_file, at.axis.key, at.axis.values[j]); !problem.empty()) {
+        if (const std::string problem = RigAxisProblem(rig_file, at.axis.key, at.axis.values[j], presets); !problem.empty()) {
           at.node["values"][j].Fail(problem);
         }
       }
@@ -341,7 +351,8 @@ SweepSpec LoadSweepSpec(const fs::path& file) {
     const bool track_key = v.key.rfind("track.", 0) == 0 && v.key.size() > 6;
     if (!track_key && !IsRigAxisKey(v.key) && std::find(ValueKeys().begin(), ValueKeys().end(), v.key) == ValueKeys().end()) {
       a["key"].Fail("not a key a sweep can vary (scene, rig, avatar, motion, sensor, seed, frames, "
-                    "background_frames, track.<setting>, rig.cameras, rig.resolution, rig.focal_scale, rig.dist)");
+                    "background_frames, track.<setting>, rig.cameras, rig.resolution, rig.focal_scale, rig.dist, "
+                    "sensor.<group>.<knob>)");
     }
     if (!names.insert(v.key).second) a["key"].Fail("'" + v.key + "' is swept twice");
     const JsonNode values = a["values"];
@@ -543,12 +554,16 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
         if (p->has_up) camera["up"] = {p->up.x(), p->up.y(), p->up.z()};
       }
     }
-    // Then the rig axes, in RigAxisKeys()'s order.
+    // Then the rig axes, in RigAxisKeys()'s order, then the sensor knobs.
     for (const std::string& key : RigAxisKeys()) {
       for (size_t k = 0; k < spec.axes.size(); ++k) {
         const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis);
         if (v && v->key == key) ApplyRigAxis(key, point.at[k].value, &rig);
       }
+    }
+    for (size_t k = 0; k < spec.axes.size(); ++k) {
+      const auto* v = std::get_if<ValueAxis>(&spec.axes[k].axis);
+      if (v && IsSensorKnobKey(v->key)) ApplyRigAxis(v->key, point.at[k].value, &rig);
     }
     fs::create_directories(rigs);
     const fs::path file = fs::absolute(rigs / (PointName(point.index) + ".json"));

@@ -14,6 +14,8 @@
 
 #include "common/error.h"
 #include "sim/camera/rig.h"
+#include "sim/sensor/sensor_model.h"
+#include "sim/sequence/render_job.h"
 #include "sim/motion/keyframes.h"
 
 namespace irbench {
@@ -263,6 +265,51 @@ TEST(SweepSpecTest, RigAxesMakeEachPointsRig) {
   }
 }
 
+TEST(SweepSpecTest, SensorKnobAxesSetEveryCamerasKnobOnThePointsPreset) {
+  const SweepSpec spec = LoadSweepSpec(Write("knob_axes.json", R"({"format": "irbench.sweep/1", "name": "k",
+    "base": {"rig": "theater4", "motion": "wave", "frames": 3},
+    "axes": [{"key": "sensor", "values": ["thesis", "clean"]},
+             {"key": "sensor.flicker.mains_depth", "values": [0.0, 0.3]},
+             {"key": "sensor.sensor.bit_depth", "values": [10]},
+             {"key": "rig.cameras", "values": [3]}]})"));
+  ASSERT_EQ(PointCount(spec), 4);
+  for (int i = 0; i < PointCount(spec); ++i) {
+    const SweepPoint p = PointAt(spec, i);
+    const RenderInputs in = LoadRenderInputs(PointScenario(spec, p, Dir()).render);
+    const std::string preset = p.at[0].value.get<std::string>();
+    const SensorSetup expected = *SensorPreset(preset);
+    ASSERT_EQ(in.sensors.size(), 3u) << i;  // the knobs reach the cameras rig.cameras keeps
+    for (size_t c = 0; c < in.sensors.size(); ++c) {
+      EXPECT_EQ(in.sensors[c].preset, preset) << i;
+      EXPECT_EQ(in.sensors[c].flicker.mains_depth, p.at[1].value.get<double>()) << i << " " << c;
+      EXPECT_EQ(in.sensors[c].sensor.bit_depth, 10) << i << " " << c;
+      // Knobs no axis names stay the preset's.
+      EXPECT_EQ(in.sensors[c].sensor.full_well_e, expected.sensor.full_well_e) << i;
+      EXPECT_EQ(in.sensors[c].flicker.mains_hz, expected.flicker.mains_hz) << i;
+      EXPECT_EQ(in.sensors[c].optics.f_number, expected.optics.f_number) << i;
+      EXPECT_TRUE(in.sensor_active[c]) << i << " " << c;  // a knob on `clean` models a sensor
+    }
+  }
+}
+
+// The specs shipped in ci/sweeps/ load (their avatars, motions, rigs and
+// values still exist and pass the checks), and each has points.
+TEST(SweepSpecTest, ShippedSpecsLoad) {
+  int specs = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(IRBENCH_SOURCE_DIR) / "ci" / "sweeps")) {
+    if (entry.path().extension() != ".json") continue;
+    ++specs;
+    try {
+      const SweepSpec spec = LoadSweepSpec(entry.path());
+      EXPECT_EQ(spec.name, entry.path().stem().string());
+      EXPECT_GT(PointCount(spec), 0) << entry.path();
+    } catch (const InputError& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
+  EXPECT_GE(specs, 5);
+}
+
 TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
   const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
       {"unknown_axis", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
@@ -295,6 +342,18 @@ TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
          "axes": [{"key": "rig.cameras", "values": [["front_left", "back"]]}]})", "axes[0].values[0]"},
       {"too_many_cameras", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
          "axes": [{"key": "rig.cameras", "values": [5]}]})", "axes[0].values[0]"},
+      {"knob_without_group", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "sensor.mains_depth", "values": [0.1]}]})", "axes[0].key"},
+      {"unknown_knob", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "sensor.flicker.depth", "values": [0.1]}]})", "axes[0].values[0]"},
+      {"unknown_group", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "sensor.lens.f_number", "values": [2]}]})", "axes[0].values[0]"},
+      {"knob_out_of_range", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "sensor.flicker.mains_depth", "values": [0.1, 1.5]}]})", "axes[0].values[1]"},
+      {"knob_wrong_type", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "sensor.sensor.bit_depth", "values": [10, 10.5]}]})", "axes[0].values[1]"},
+      {"knob_text", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"key": "sensor.sensor.noise", "values": ["off"]}]})", "axes[0].values[0]"},
       {"resolution", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
          "axes": [{"key": "rig.resolution", "values": [[640, 480], [4, 3]]}]})", "axes[0].values[1]"},
       {"zoom", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
