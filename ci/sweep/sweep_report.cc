@@ -63,8 +63,9 @@ std::string AxisText(const SweepAxis& axis, const AxisValue& at) {
     for (size_t d = 0; d < names.size(); ++d) out += (d ? ", " : "") + names[d] + " " + Short(at.pose[d]);
     return out;
   }
-  if (std::holds_alternative<PlacementAxis>(axis.axis)) {
-    return CoordinateText(nlohmann::json{at.position.x(), at.position.y(), at.position.z()});
+  if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
+    return CoordinateText(nlohmann::json{at.position.x(), at.position.y(), at.position.z()}) +
+           (p->aims ? " pan " + Short(at.pan) + "° tilt " + Short(at.tilt) + "°" : "");
   }
   return CoordinateText(at.value);
 }
@@ -83,6 +84,8 @@ SweepPoint FromCoordinates(const SweepSpec& spec, int index, const nlohmann::jso
     } else if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
       at.along = c.value(name + ".along", 0.0);
       at.height = c.value(name + ".height", 0.0);
+      at.pan = c.value(name + ".pan", 0.0);
+      at.tilt = c.value(name + ".tilt", 0.0);
       const nlohmann::json p = c.value(name + ".position", nlohmann::json::array({0, 0, 0}));
       at.position = {p[0].get<double>(), p[1].get<double>(), p[2].get<double>()};
     } else {
@@ -160,8 +163,9 @@ std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const st
   for (const SweepAxis& axis : spec.axes) {
     if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
       for (const std::string& dim : PoseNames(*pose)) out << "," << axis.name << "." << dim;
-    } else if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+    } else if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
       for (const char* c : {".along", ".height", ".x", ".y", ".z"}) out << "," << axis.name << c;
+      if (p->aims) out << "," << axis.name << ".pan," << axis.name << ".tilt";
     } else {
       out << "," << axis.name;
     }
@@ -174,9 +178,10 @@ std::string Csv(const SweepSpec& spec, const std::vector<Done>& points, const st
       const AxisValue& at = d.point.at[k];
       if (std::holds_alternative<PoseAxis>(spec.axes[k].axis)) {
         for (const double v : at.pose) out << "," << Num(v);
-      } else if (std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) {
+      } else if (const auto* p = std::get_if<PlacementAxis>(&spec.axes[k].axis)) {
         out << "," << Num(at.along) << "," << Num(at.height) << "," << Num(at.position.x()) << ","
             << Num(at.position.y()) << "," << Num(at.position.z());
+        if (p->aims) out << "," << Num(at.pan) << "," << Num(at.tilt);
       } else {
         out << "," << CsvField(CoordinateText(at.value));
       }
@@ -232,11 +237,16 @@ std::string AxisTables(const SweepSpec& spec, const std::vector<Done>& points) {
       by[key].first += it->second;
       ++by[key].second;
     };
-    const bool placed = std::holds_alternative<PlacementAxis>(axis.axis);
+    const auto* placed = std::get_if<PlacementAxis>(&axis.axis);
     if (!std::holds_alternative<ValueAxis>(axis.axis) && spec.mode != "grid") continue;  // continuous
     for (const Done& d : points) {
       const AxisValue& at = d.point.at[k];
-      add(placed ? "height " + Short(at.height) + " m, along " + Short(at.along) : AxisText(axis, at), d);
+      std::string key = AxisText(axis, at);
+      if (placed) {
+        key = "height " + Short(at.height) + " m, along " + Short(at.along) +
+              (placed->aims ? ", pan " + Short(at.pan) + "°, tilt " + Short(at.tilt) + "°" : "");
+      }
+      add(key, d);
     }
     out << "\n### " << axis.name << "\n\n| " << (placed ? "placement" : axis.name) << " | points | mean "
         << spec.metric << " |\n|---|---|---|\n";
@@ -248,12 +258,16 @@ std::string AxisTables(const SweepSpec& spec, const std::vector<Done>& points) {
 }
 
 // An SVG heat map of one placement axis: the metric (mean over the other
-// axes) at each position along the line and height; green best, red worst.
+// axes; with aim ranges, at the position's best aim) at each position along
+// the line and height; green best, red worst.
 std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& points) {
   const auto& p = std::get<PlacementAxis>(spec.axes[k].axis);
+  const bool higher = HigherIsBetter(spec.metric);
   struct Cell {
-    double along, height, sum = 0;
-    int n = 0;
+    double along, height;
+    std::map<std::pair<double, double>, std::pair<double, int>> by_aim;  // (pan, tilt) -> (sum, count)
+    double value = 0;
+    std::pair<double, double> aim;  // the best
   };
   std::map<std::pair<long, long>, Cell> cells;
   for (const Done& d : points) {
@@ -262,17 +276,24 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
     const AxisValue& at = d.point.at[k];
     const std::pair<long, long> key = spec.mode == "grid" ? std::make_pair(long(at.along_step), long(at.height_step))
                                                             : std::make_pair(long(d.index), 0L);
-    Cell& c = cells.try_emplace(key, Cell{at.along, at.height}).first->second;
-    c.sum += it->second;
-    ++c.n;
+    auto& [sum, n] = cells.try_emplace(key, Cell{at.along, at.height}).first->second.by_aim[{at.pan, at.tilt}];
+    sum += it->second;
+    ++n;
   }
   if (cells.empty()) return "";
+  for (auto& [key, c] : cells) {
+    bool first = true;
+    for (const auto& [aim, sum_n] : c.by_aim) {
+      const double v = sum_n.first / sum_n.second;
+      if (first || (higher ? v > c.value : v < c.value)) c.value = v, c.aim = aim;
+      first = false;
+    }
+  }
   // Colour by rank (one outlier would wash out a linear scale).
   std::vector<double> values;
-  for (const auto& [key, c] : cells) values.push_back(c.sum / c.n);
+  for (const auto& [key, c] : cells) values.push_back(c.value);
   std::sort(values.begin(), values.end());
   const double lo = values.front(), hi = values.back();
-  const bool higher = HigherIsBetter(spec.metric);
   const auto badness = [&](double v) {
     if (values.size() < 2) return 0.0;
     const double rank = double(std::lower_bound(values.begin(), values.end(), v) - values.begin()) / (values.size() - 1);
@@ -285,8 +306,9 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
   svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << left + w + 20 << "\" height=\"" << top + h + bottom
       << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
   for (const auto& [key, c] : cells) {
-    const double v = c.sum / c.n;
+    const double v = c.value;
     const double bad = badness(v);
+    const std::string aim = p.aims ? " at pan " + Short(c.aim.first) + "°, tilt " + Short(c.aim.second) + "°" : "";
     char colour[32];
     std::snprintf(colour, sizeof(colour), "rgb(%d,%d,70)", int(40 + 200 * bad), int(190 - 150 * bad));
     const double fx = c.along, fy = hmax > hmin ? (c.height - hmin) / (hmax - hmin) : 0.5;
@@ -295,10 +317,11 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
       const double x = left + (cols > 1 ? fx * (cols - 1) : 0) * cw, y = top + h - ch - (rows > 1 ? fy * (rows - 1) : 0) * ch;
       svg << "<rect x=\"" << x << "\" y=\"" << y << "\" width=\"" << cw - 1 << "\" height=\"" << ch - 1
           << "\" fill=\"" << colour << "\"/><text x=\"" << x + cw / 2 << "\" y=\"" << y + ch / 2 + 4
-          << "\" text-anchor=\"middle\" fill=\"white\">" << Short(v) << "</text>\n";
+          << "\" text-anchor=\"middle\" fill=\"white\">" << Short(v) << "<title>" << Short(v) << aim
+          << "</title></text>\n";
     } else {
       svg << "<circle cx=\"" << left + fx * w << "\" cy=\"" << top + h - fy * h << "\" r=\"7\" fill=\"" << colour
-          << "\"><title>" << Short(v) << "</title></circle>\n";
+          << "\"><title>" << Short(v) << aim << "</title></circle>\n";
     }
   }
   const Eigen::Vector3d a = {p.from.x(), p.from.y(), 0}, b = {p.to.x(), p.to.y(), 0};
@@ -306,7 +329,7 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
       << Short(a.y()) << ")</text><text x=\"" << left + w << "\" y=\"" << top + h + 18
       << "\" text-anchor=\"end\">(" << Short(b.x()) << ", " << Short(b.y()) << ")</text>\n"
       << "<text x=\"" << left + w / 2 << "\" y=\"" << top + h + 38 << "\" text-anchor=\"middle\">camera " << p.camera
-      << ": " << spec.metric << ", coloured by rank (green best: " << Short(higher ? hi : lo) << ", red worst: "
+      << ": " << spec.metric << (p.aims ? " at each position's best aim" : "") << ", coloured by rank (green best: " << Short(higher ? hi : lo) << ", red worst: "
       << Short(higher ? lo : hi) << ")</text>\n"
       << "<text x=\"" << left - 6 << "\" y=\"" << top + h << "\" text-anchor=\"end\">" << Short(hmin)
       << " m</text><text x=\"" << left - 6 << "\" y=\"" << top + 10 << "\" text-anchor=\"end\">" << Short(hmax)

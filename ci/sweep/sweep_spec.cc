@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <fstream>
 #include <set>
+#include <tuple>
+
+#include <Eigen/Geometry>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -56,7 +59,7 @@ SweepRange ReadRange(const JsonNode& node, bool grid) {
 }
 
 PlacementAxis ReadPlacement(const JsonNode& a, bool grid) {
-  a.CheckKeys({"camera", "along", "height", "look_at", "up"});
+  a.CheckKeys({"camera", "along", "height", "look_at", "up", "pan", "tilt"});
   PlacementAxis p;
   p.camera = a.GetString("camera");
   const JsonNode along = a["along"];
@@ -71,6 +74,15 @@ PlacementAxis ReadPlacement(const JsonNode& a, bool grid) {
   if (a.Has("up")) {
     p.has_up = true;
     p.up = a["up"].Vec3();
+    if (!p.up.allFinite() || p.up.norm() < 1e-9) a["up"].Fail("a zero or non-finite vector");
+  }
+  for (const auto& [key, range, limit] : {std::tuple{"pan", &p.pan, 180.0}, std::tuple{"tilt", &p.tilt, 85.0}}) {
+    if (!a.Has(key)) continue;
+    p.aims = true;
+    *range = ReadRange(a[key], grid);
+    if (std::abs(range->from) > limit || std::abs(range->to) > limit) {
+      a[key].Fail("degrees within ±" + std::to_string(int(limit)));
+    }
   }
   return p;
 }
@@ -128,6 +140,16 @@ std::string Vec(const Eigen::Vector3d& v) {
   return buf;
 }
 
+// The up a placed camera keeps: the placement's, else the rig file's for it
+// (LoadRig's default: +z).
+Eigen::Vector3d PlacedUp(const PlacementAxis& p, const nlohmann::json& rig_camera) {
+  if (p.has_up) return p.up;
+  if (rig_camera.contains("up") && rig_camera["up"].is_array() && rig_camera["up"].size() == 3) {
+    return {rig_camera["up"][0].get<double>(), rig_camera["up"][1].get<double>(), rig_camera["up"][2].get<double>()};
+  }
+  return Eigen::Vector3d(0, 0, 1);
+}
+
 // Every corner of a placement inside the scene's bounds, the camera in the rig.
 void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& place) {
   bool found = false;
@@ -145,6 +167,33 @@ void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& p
                                                 "' " + Vec(place.lo) + " to " + Vec(place.hi));
       }
       if ((at - p.look_at).norm() < 1e-6) a["look_at"].Fail("the camera at " + Vec(at) + " is at its look_at");
+    }
+  }
+  if (!a.Has("tilt")) return;
+  // Every corner's view, tilted, stays more than 5° off the camera's up and
+  // down (a pan about the up keeps the elevation; a tilt past it would turn
+  // the camera over).
+  nlohmann::json rig_camera;
+  {
+    std::ifstream in(place.rig_file);
+    for (const nlohmann::json& c : nlohmann::json::parse(in)["cameras"]) {
+      if (c.value("name", "") == p.camera) rig_camera = c;
+    }
+  }
+  const Eigen::Vector3d up = PlacedUp(p, rig_camera).normalized();
+  for (const double along : {0.0, 1.0}) {
+    for (const double height : {p.height.from, p.height.to}) {
+      const Eigen::Vector3d at = PlacementPosition(p, along, height);
+      const double elevation = std::asin(std::clamp((p.look_at - at).normalized().dot(up), -1.0, 1.0)) * 180 / M_PI;
+      for (const double tilt : {p.tilt.from, p.tilt.to}) {
+        if (std::abs(elevation + tilt) > 85) {
+          char angles[96];
+          std::snprintf(angles, sizeof(angles), " looks %.3g° above the horizontal; tilted %g° it would look at %.3g°",
+                        elevation, tilt, elevation + tilt);
+          a["tilt"].Fail("the camera at " + Vec(at) + angles + " (a tilted view stays within ±85° of the horizontal, " +
+                         "up being " + Vec(up) + ")");
+        }
+      }
     }
   }
 }
@@ -249,7 +298,8 @@ std::vector<double> SearchUnit(const SweepSpec& spec, int index, const PointMetr
   size_t dims = 0;
   for (const SweepAxis& axis : spec.axes) {
     const auto* pose = std::get_if<PoseAxis>(&axis.axis);
-    dims += pose ? pose->dims.size() : 2;
+    const auto* placed = std::get_if<PlacementAxis>(&axis.axis);
+    dims += pose ? pose->dims.size() : placed && placed->aims ? 4 : 2;
   }
   const int generation = index / spec.population;
   const double sign = SeeksHigh(spec) ? -1 : 1;  // smaller is better below
@@ -281,7 +331,9 @@ std::vector<double> SearchUnit(const SweepSpec& spec, int index, const PointMetr
 }
 
 size_t AxisSize(const SweepAxis& axis) {
-  if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) return size_t(p->steps) * p->height.steps;
+  if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
+    return size_t(p->steps) * p->height.steps * p->pan.steps * p->tilt.steps;
+  }
   if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
     size_t n = 1;
     for (const PoseDim& d : pose->dims) n *= size_t(d.range.steps);
@@ -291,6 +343,20 @@ size_t AxisSize(const SweepAxis& axis) {
 }
 
 }  // namespace
+
+Eigen::Vector3d AimedLookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& look_at,
+                            const Eigen::Vector3d& up, double pan_deg, double tilt_deg) {
+  if (pan_deg == 0 && tilt_deg == 0) return look_at;
+  const Eigen::Vector3d to = look_at - position;
+  const double distance = to.norm();
+  const Eigen::Vector3d u = up.normalized();
+  // Pan about the up; then tilt about the right (view x up), which turns the
+  // view towards the up.
+  Eigen::Vector3d view = Eigen::AngleAxisd(pan_deg * M_PI / 180, u) * (to / distance);
+  const Eigen::Vector3d right = view.cross(u);
+  if (right.norm() > 1e-12) view = Eigen::AngleAxisd(tilt_deg * M_PI / 180, right.normalized()) * view;
+  return position + distance * view;
+}
 
 std::string PointName(int index) {
   char buf[24];
@@ -442,6 +508,10 @@ SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_o
       const auto& p = std::get<PlacementAxis>(spec.axes[k].axis);
       at.along = unit[u++];
       at.height = p.height.from + (p.height.to - p.height.from) * unit[u++];
+      if (p.aims) {
+        at.pan = p.pan.from + (p.pan.to - p.pan.from) * unit[u++];
+        at.tilt = p.tilt.from + (p.tilt.to - p.tilt.from) * unit[u++];
+      }
       at.position = PlacementPosition(p, at.along, at.height);
     }
     return point;
@@ -470,13 +540,22 @@ SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_o
       }
     } else if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
       if (grid) {
+        // Along fastest, then height, pan, tilt.
         at.along_step = static_cast<int>(cell % p->steps);
-        at.height_step = static_cast<int>(cell / p->steps);
+        cell /= p->steps;
+        at.height_step = static_cast<int>(cell % p->height.steps);
+        cell /= p->height.steps;
         at.along = p->steps <= 1 ? 0.0 : double(at.along_step) / (p->steps - 1);
         at.height = p->height.At(at.height_step);
+        at.pan = p->pan.At(static_cast<int>(cell % p->pan.steps));
+        at.tilt = p->tilt.At(static_cast<int>(cell / p->pan.steps));
       } else {
         at.along = Uniform(spec.seed, index, k, 0);
         at.height = p->height.from + (p->height.to - p->height.from) * Uniform(spec.seed, index, k, 1);
+        if (p->aims) {
+          at.pan = p->pan.from + (p->pan.to - p->pan.from) * Uniform(spec.seed, index, k, 2);
+          at.tilt = p->tilt.from + (p->tilt.to - p->tilt.from) * Uniform(spec.seed, index, k, 3);
+        }
       }
       at.position = PlacementPosition(*p, at.along, at.height);
     } else {
@@ -497,10 +576,14 @@ nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point) 
       for (size_t d = 0; d < pose->dims.size(); ++d) {
         out[axis.name + "." + pose->dims[d].joint + "." + "xyz"[pose->dims[d].component]] = at.pose[d];
       }
-    } else if (std::holds_alternative<PlacementAxis>(axis.axis)) {
+    } else if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
       out[axis.name + ".along"] = at.along;
       out[axis.name + ".height"] = at.height;
       out[axis.name + ".position"] = {at.position.x(), at.position.y(), at.position.z()};
+      if (p->aims) {
+        out[axis.name + ".pan"] = at.pan;
+        out[axis.name + ".tilt"] = at.tilt;
+      }
     } else {
       out[axis.name] = at.value;
     }
@@ -549,8 +632,10 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
       for (nlohmann::json& camera : rig["cameras"]) {
         if (camera.value("name", "") != p->camera) continue;
         const Eigen::Vector3d& at = point.at[k].position;
+        const Eigen::Vector3d look_at =
+            AimedLookAt(at, p->look_at, PlacedUp(*p, camera), point.at[k].pan, point.at[k].tilt);
         camera["position"] = {at.x(), at.y(), at.z()};
-        camera["look_at"] = {p->look_at.x(), p->look_at.y(), p->look_at.z()};
+        camera["look_at"] = {look_at.x(), look_at.y(), look_at.z()};
         if (p->has_up) camera["up"] = {p->up.x(), p->up.y(), p->up.z()};
       }
     }

@@ -1,16 +1,16 @@
 #pragma once
 // A sweep spec (irbench.sweep/1, docs/sweeps.md): a base scenario in a
-// suite's terms, axes — camera placements along a wall or ceiling line and
-// over heights, lists of values for a scenario key (rig, avatar, motion,
-// sensor, seed, frames, track.<setting>) or for the point's rig
-// (rig.cameras, rig.resolution, rig.focal_scale, rig.dist: sweep_rig.h) —
-// and a mode: `grid` (every combination), seeded `random` samples, or
-// `search`: the cross-entropy method over the placements, generation by
-// generation, each generation drawn around the best points of the ones
-// before. Points are numbered; a
-// point's coordinates depend only on the spec, its index and (search) the
-// metrics of the earlier generations' points, so any process (a local worker,
-// a Slurm array task) can run point i alone.
+// suite's terms, axes — camera placements along a wall or ceiling line, over
+// heights, pans and tilts; lists of values for a scenario key (rig, avatar,
+// motion, sensor, seed, frames, track.<setting>) or for the point's rig
+// (rig.cameras, rig.resolution, rig.focal_scale, rig.dist and the sensor
+// knobs sensor.<group>.<knob>: sweep_rig.h); arm poses — and a mode: `grid`
+// (every combination), seeded `random` samples, or `search`: the
+// cross-entropy method over the placements, generation by generation, each
+// generation drawn around the best points of the ones before. Points are
+// numbered; a point's coordinates depend only on the spec, its index and
+// (search) the metrics of the earlier generations' points, so any process (a
+// local worker, a Slurm array task) can run point i alone.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -34,7 +34,9 @@ struct SweepRange {
 };
 
 // One camera moved along a line on a wall or the ceiling (x, y in metres, at
-// each height), aimed at `look_at`.
+// each height), aimed at `look_at`, then turned by `pan` degrees about its up
+// (positive: to the left, counter-clockwise seen from above) and tilted by
+// `tilt` degrees towards its up: a tripod head's two angles.
 struct PlacementAxis {
   std::string camera;
   Eigen::Vector2d from = Eigen::Vector2d::Zero(), to = Eigen::Vector2d::Zero();
@@ -43,6 +45,8 @@ struct PlacementAxis {
   Eigen::Vector3d look_at = Eigen::Vector3d(0, 0, 1);
   bool has_up = false;
   Eigen::Vector3d up = Eigen::Vector3d(0, 0, 1);
+  bool aims = false;  // the spec gives `pan` or `tilt`
+  SweepRange pan, tilt;
 };
 
 // An arm pose held (sweep_pose.h): joint rotations in the keyframe
@@ -93,6 +97,7 @@ struct SweepSpec {
 struct AxisValue {
   double along = 0;   // placement: 0..1 from `from` to `to`
   double height = 0;  // placement: metres
+  double pan = 0, tilt = 0;  // placement: degrees
   int along_step = -1, height_step = -1;  // grid: the steps; random: -1
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   nlohmann::json value;  // value axis
@@ -122,6 +127,12 @@ int GenerationCount(const SweepSpec& spec);
 // measured nothing).
 using PointMetric = std::function<std::optional<double>(int index)>;
 
+// Where a camera at `position` aimed at `look_at` with `up` looks after the
+// placement's pan and tilt (degrees; PlacementAxis): the point at the same
+// distance along the turned direction; `look_at` itself when both are 0.
+Eigen::Vector3d AimedLookAt(const Eigen::Vector3d& position, const Eigen::Vector3d& look_at,
+                            const Eigen::Vector3d& up, double pan_deg, double tilt_deg);
+
 // Point `index` (0 <= index < PointCount): grid in row-major order over the
 // axes (the last axis fastest); random from a hash of (seed, index, axis);
 // search from the seed and the earlier generations' metrics (`metric_of`;
@@ -129,7 +140,8 @@ using PointMetric = std::function<std::optional<double>(int index)>;
 SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_of = {});
 
 // {"<camera>.along": .., "<camera>.height": .., "<camera>.position": [x,y,z],
-// "<key>": value, ...}
+// (a placement with aim ranges) "<camera>.pan": .., "<camera>.tilt": ..,
+// "<camera>.look_at": [x,y,z], "<key>": value, ...}
 nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point);
 
 // The point's scenario: the base with the point's values; a placement writes

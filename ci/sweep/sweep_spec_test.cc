@@ -265,6 +265,46 @@ TEST(SweepSpecTest, RigAxesMakeEachPointsRig) {
   }
 }
 
+// Pan and tilt as a tripod head turns them: the view's azimuth about +z
+// (the side camera's up) grows by the pan, its elevation by the tilt, and the
+// horizon stays level; against spherical coordinates, through the rig file.
+TEST(SweepSpecTest, AimRangesPanAndTiltTheCameraLikeATripodHead) {
+  const SweepSpec spec = LoadSweepSpec(Write("aim.json", R"({"format": "irbench.sweep/1", "name": "a",
+    "base": {"rig": "theater4", "motion": "wave", "frames": 3},
+    "axes": [{"camera": "side", "along": {"from": [-3.6, -1.0], "to": [-3.6, 1.0], "steps": 2}, "height": 2.2,
+              "look_at": [0, 0, 1.1], "pan": {"from": -20, "to": 30, "steps": 3}, "tilt": {"from": -10, "to": 5, "steps": 2}},
+             {"key": "rig.dist", "values": [[0, 0, 0, 0, 0]]}]})"));
+  ASSERT_EQ(PointCount(spec), 2 * 3 * 2);
+  std::set<std::tuple<double, double, double>> seen;
+  for (int i = 0; i < PointCount(spec); ++i) {
+    const SweepPoint p = PointAt(spec, i);
+    const AxisValue& at = p.at[0];
+    seen.insert({at.along, at.pan, at.tilt});
+    const nlohmann::json c = PointCoordinates(spec, p);
+    EXPECT_EQ(c["side.pan"].get<double>(), at.pan);
+    EXPECT_EQ(c["side.tilt"].get<double>(), at.tilt);
+    const Rig rig = LoadRig(PointScenario(spec, p, Dir()).render.rig);
+    const Camera* side = nullptr;
+    for (const Camera& cam : rig.cameras) {
+      if (cam.name == "side") side = &cam;
+    }
+    ASSERT_NE(side, nullptr);
+    const Eigen::Vector3d to = Eigen::Vector3d(0, 0, 1.1) - at.position;
+    const double azimuth = std::atan2(to.y(), to.x()) + at.pan * M_PI / 180;
+    const double elevation = std::asin(to.z() / to.norm()) + at.tilt * M_PI / 180;
+    const Eigen::Vector3d view(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                               std::sin(elevation));
+    // The view's ray lands on the principal point ...
+    EXPECT_LT((side->Project(at.position + 2 * view) - Eigen::Vector2d(side->cx, side->cy)).norm(), 1e-6) << i;
+    // ... and a point beside it, level with it, on the principal row.
+    const Eigen::Vector3d left(-std::sin(azimuth), std::cos(azimuth), 0);
+    const Eigen::Vector2d beside = side->Project(at.position + 2 * view + 0.3 * left);
+    EXPECT_NEAR(beside.y(), side->cy, 1e-6) << i;
+    EXPECT_LT(beside.x(), side->cx) << i;  // left is left in the image
+  }
+  EXPECT_EQ(seen.size(), 12u);  // every along x pan x tilt once
+}
+
 TEST(SweepSpecTest, SensorKnobAxesSetEveryCamerasKnobOnThePointsPreset) {
   const SweepSpec spec = LoadSweepSpec(Write("knob_axes.json", R"({"format": "irbench.sweep/1", "name": "k",
     "base": {"rig": "theater4", "motion": "wave", "frames": 3},
@@ -342,6 +382,12 @@ TEST(SweepSpecTest, BadSpecsNameTheFileAndField) {
          "axes": [{"key": "rig.cameras", "values": [["front_left", "back"]]}]})", "axes[0].values[0]"},
       {"too_many_cameras", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
          "axes": [{"key": "rig.cameras", "values": [5]}]})", "axes[0].values[0]"},
+      {"pan_too_far", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"camera": "side", "along": {"from": [-3, 0], "to": [-3, 1], "steps": 2}, "height": 2,
+                   "pan": {"from": -200, "to": 0, "steps": 2}}]})", "axes[0].pan"},
+      {"tilt_to_the_ceiling", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
+         "axes": [{"camera": "side", "along": {"from": [-3, 0], "to": [-3, 1], "steps": 2}, "height": 2,
+                   "look_at": [0, 0, 3], "tilt": {"from": 0, "to": 80, "steps": 2}}]})", "axes[0].tilt"},
       {"knob_without_group", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
          "axes": [{"key": "sensor.mains_depth", "values": [0.1]}]})", "axes[0].key"},
       {"unknown_knob", R"({"format": "irbench.sweep/1", "name": "b", "base": {},
