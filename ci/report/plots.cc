@@ -28,15 +28,6 @@ double BinWidth(double span) {
   return 10 * p;
 }
 
-std::string Quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 // One series per file, "frame value" rows; a blank line where frames are
 // skipped so that gnuplot breaks the line there.
 void WriteSeries(const fs::path& path, const std::vector<std::tuple<int, double, bool>>& rows) {
@@ -51,6 +42,15 @@ void WriteSeries(const fs::path& path, const std::vector<std::tuple<int, double,
 }
 
 }  // namespace
+
+std::string GnuplotQuoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
 
 std::optional<fs::path> FindGnuplot() {
   if (const char* env = std::getenv("IRBENCH_GNUPLOT")) {
@@ -123,7 +123,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
     }
     std::string title = TitleCase(joint);
     if (outliers) title += " (" + std::to_string(outliers) + " outlier" + (outliers > 1 ? "s" : "") + ")";
-    gp << "set title " << Quoted(title) << "\n";
+    gp << "set title " << GnuplotQuoted(title) << "\n";
     if (kept.empty()) {
       gp << "unset xtics; unset ytics; set label 1 \"not scored\" at graph 0.5, graph 0.5 center\n"
          << "plot [0:1] [0:1] 2 notitle\n"
@@ -140,7 +140,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
     const std::string file = "hist_" + joint + ".dat";
     AtomicWriteFile(workdir / file, data.str());
     gp << "set boxwidth " << width << "\n"
-       << "plot [0:" << bins * width << "] [0:*] " << Quoted(file)
+       << "plot [0:" << bins * width << "] [0:*] " << GnuplotQuoted(file)
        << " using 1:2 with boxes lc rgb \"#4f8fcf\" notitle\n";
   }
   gp << "unset multiplot\n";
@@ -155,15 +155,15 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
   auto series_plot = [&](const std::map<std::string, std::vector<std::tuple<int, double, bool>>>& series,
                          const std::vector<std::string>& names, const std::string& prefix,
                          const std::string& title_suffix, const std::string& ylabel) {
-    gp << "set ylabel " << Quoted(ylabel) << "\n";
+    gp << "set ylabel " << GnuplotQuoted(ylabel) << "\n";
     std::vector<std::string> parts;
     for (size_t i = 0; i < names.size(); ++i) {
       const auto it = series.find(names[i]);
       if (it == series.end() || it->second.empty()) continue;
       const std::string file = prefix + names[i] + ".dat";
       WriteSeries(workdir / file, it->second);
-      parts.push_back(Quoted(file) + " using 1:2 with lines lw 1.5 lc rgb \"" + colours[i % 9] + "\" title " +
-                      Quoted(TitleCase(names[i]) + title_suffix));
+      parts.push_back(GnuplotQuoted(file) + " using 1:2 with lines lw 1.5 lc rgb \"" + colours[i % 9] + "\" title " +
+                      GnuplotQuoted(TitleCase(names[i]) + title_suffix));
     }
     if (parts.empty()) {
       gp << "set label 1 \"not scored\" at graph 0.5, graph 0.5 center\nplot [0:1] [0:1] 2 notitle\nunset label 1\n";
@@ -193,9 +193,9 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
     for (size_t i = 0; i < cameras.size(); ++i) {
       const std::string file = "silhouette_iou_" + cameras[i] + ".dat";
       WriteSeries(workdir / file, by_camera[cameras[i]]);
-      gp << (i ? ", \\\n     " : "") << Quoted(file) << " using 1:2 with linespoints pt 7 ps 0.2 lw 1.5 lc rgb \""
+      gp << (i ? ", \\\n     " : "") << GnuplotQuoted(file) << " using 1:2 with linespoints pt 7 ps 0.2 lw 1.5 lc rgb \""
          << colours[i % 9]
-         << "\" title " << Quoted(cameras[i]) << " noenhanced";
+         << "\" title " << GnuplotQuoted(cameras[i]) << " noenhanced";
     }
     gp << "\n";
     names.push_back("silhouettes_over_time");

@@ -16,6 +16,9 @@ namespace irbench {
 // gnuplot"), otherwise `gnuplot` found on PATH. nullopt when there is none.
 std::optional<std::filesystem::path> FindGnuplot();
 
+// `s` as a gnuplot string literal ("..." with " and \ escaped).
+std::string GnuplotQuoted(const std::string& s);
+
 // Runs `gnuplot script_file` in `workdir`. Throws RuntimeError with what
 // gnuplot printed when it fails.
 void RunGnuplot(const std::filesystem::path& gnuplot, const std::filesystem::path& workdir,

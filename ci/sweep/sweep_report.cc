@@ -8,12 +8,15 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "ci/report/plots.h"
 #include "ci/report/report.h"
 #include "ci/score/score.h"
 #include "ci/sweep/sweep.h"
+#include "ci/sweep/sweep_plots.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/json_reader.h"
+#include "common/logging.h"
 
 namespace irbench {
 namespace fs = std::filesystem;
@@ -223,35 +226,56 @@ std::string RankTable(const SweepSpec& spec, const std::vector<Done>& ranked) {
   return out.str();
 }
 
-// Markdown: per axis, the metric's mean over the points at each of its values.
-std::string AxisTables(const SweepSpec& spec, const std::vector<Done>& points) {
-  std::ostringstream out;
+// Per axis (value axes; on a grid also placements and poses), the metric
+// over the points at each of its values, in the order they first appear.
+std::vector<std::pair<size_t, AxisSummary>> AxisSummaries(const SweepSpec& spec, const std::vector<Done>& points) {
+  std::vector<std::pair<size_t, AxisSummary>> out;
   for (size_t k = 0; k < spec.axes.size(); ++k) {
     const SweepAxis& axis = spec.axes[k];
-    std::map<std::string, std::pair<double, int>> by;  // value -> (sum, count)
-    std::vector<std::string> order;
-    const auto add = [&](const std::string& key, const Done& d) {
-      const auto it = d.metrics.find(spec.metric);
-      if (it == d.metrics.end()) return;
-      if (!by.count(key)) order.push_back(key);
-      by[key].first += it->second;
-      ++by[key].second;
-    };
     const auto* placed = std::get_if<PlacementAxis>(&axis.axis);
     if (!std::holds_alternative<ValueAxis>(axis.axis) && spec.mode != "grid") continue;  // continuous
+    AxisSummary summary{axis.name, {}};
+    std::map<std::string, size_t> row_of;
     for (const Done& d : points) {
+      const auto it = d.metrics.find(spec.metric);
+      if (it == d.metrics.end()) continue;
       const AxisValue& at = d.point.at[k];
       std::string key = AxisText(axis, at);
       if (placed) {
         key = "height " + Short(at.height) + " m, along " + Short(at.along) +
               (placed->aims ? ", pan " + Short(at.pan) + "°, tilt " + Short(at.tilt) + "°" : "");
       }
-      add(key, d);
+      const auto [row, added] = row_of.try_emplace(key, summary.values.size());
+      if (added) {
+        AxisValueSummary v;
+        v.label = key;
+        if (at.value.is_number()) v.x = at.value.get<double>();
+        v.min = v.max = it->second;
+        summary.values.push_back(v);
+      }
+      AxisValueSummary& v = summary.values[row->second];
+      v.mean += it->second;  // a sum until the end
+      v.min = std::min(v.min, it->second);
+      v.max = std::max(v.max, it->second);
+      ++v.points;
     }
-    out << "\n### " << axis.name << "\n\n| " << (placed ? "placement" : axis.name) << " | points | mean "
-        << spec.metric << " |\n|---|---|---|\n";
-    for (const std::string& key : order) {
-      out << "| " << key << " | " << by[key].second << " | " << Short(by[key].first / by[key].second) << " |\n";
+    for (AxisValueSummary& v : summary.values) v.mean /= v.points;
+    out.emplace_back(k, std::move(summary));
+  }
+  return out;
+}
+
+// Markdown: per axis, the metric's mean (and range) over the points at each
+// of its values.
+std::string AxisTables(const SweepSpec& spec, const std::vector<std::pair<size_t, AxisSummary>>& summaries) {
+  std::ostringstream out;
+  for (const auto& [k, summary] : summaries) {
+    const bool placed = std::holds_alternative<PlacementAxis>(spec.axes[k].axis);
+    out << "\n### " << summary.name << "\n\n| " << (placed ? "placement" : summary.name) << " | points | mean "
+        << spec.metric << " | min | max |\n|---|---|---|---|---|\n";
+    for (const AxisValueSummary& v : summary.values) {
+      out << "| " << v.label << " | " << v.points << " | " << Short(v.mean) << " | " << Short(v.min) << " | "
+          << Short(v.max) << " |\n";
     }
   }
   return out.str();
@@ -337,11 +361,10 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
   return svg.str();
 }
 
-// Markdown: a search's convergence, generation by generation.
-std::string Convergence(const SweepSpec& spec, const std::vector<Done>& points) {
+// A search's convergence, generation by generation.
+std::vector<ConvergenceRow> ConvergenceRows(const SweepSpec& spec, const std::vector<Done>& points) {
   const bool higher = SeeksHigh(spec);
-  std::ostringstream out;
-  out << "| generation | evaluations | generation's best | generation's mean | best so far |\n|---|---|---|---|---|\n";
+  std::vector<ConvergenceRow> rows;
   double best = higher ? -1e300 : 1e300;
   int evaluations = 0;
   for (int g = 0; g < GenerationCount(spec); ++g) {
@@ -357,8 +380,18 @@ std::string Convergence(const SweepSpec& spec, const std::vector<Done>& points) 
     if (n == 0) break;
     evaluations += n;
     best = higher ? std::max(best, gen_best) : std::min(best, gen_best);
-    out << "| " << g << " | " << evaluations << " | " << Short(gen_best) << " | " << Short(sum / n) << " | "
-        << Short(best) << " |\n";
+    rows.push_back({g, evaluations, gen_best, sum / n, best});
+  }
+  return rows;
+}
+
+// Markdown: the convergence table.
+std::string Convergence(const std::vector<ConvergenceRow>& rows) {
+  std::ostringstream out;
+  out << "| generation | evaluations | generation's best | generation's mean | best so far |\n|---|---|---|---|---|\n";
+  for (const ConvergenceRow& r : rows) {
+    out << "| " << r.generation << " | " << r.evaluations << " | " << Short(r.generation_best) << " | "
+        << Short(r.generation_mean) << " | " << Short(r.best_so_far) << " |\n";
   }
   return out.str();
 }
@@ -440,8 +473,23 @@ SweepCollected CollectSweep(const SweepOptions& options) {
                 "\n\nAt " + best.coordinates.dump() + ".\n\nAlone: `" + ReproduceText(sweep, best) + "`\n";
     md << "\n" << best_text;
   }
-  const std::string rank_table = RankTable(spec, ranked), axis_tables = AxisTables(spec, points);
-  const std::string convergence = spec.population > 0 ? Convergence(spec, points) : std::string();
+  const std::vector<std::pair<size_t, AxisSummary>> summaries = AxisSummaries(spec, points);
+  const std::vector<ConvergenceRow> convergence_rows =
+      spec.population > 0 ? ConvergenceRows(spec, points) : std::vector<ConvergenceRow>();
+  const std::string rank_table = RankTable(spec, ranked), axis_tables = AxisTables(spec, summaries);
+  const std::string convergence = convergence_rows.empty() ? std::string() : Convergence(convergence_rows);
+  // Charts of the value axes and the convergence (gnuplot; without it, the tables alone).
+  std::map<std::string, std::string> charts;
+  std::vector<AxisSummary> value_summaries;
+  for (const auto& [k, summary] : summaries) {
+    if (std::holds_alternative<ValueAxis>(spec.axes[k].axis)) value_summaries.push_back(summary);
+  }
+  if (const std::optional<fs::path> gnuplot = FindGnuplot()) {
+    charts = DrawSweepPlots(spec.metric, convergence_rows, value_summaries, *gnuplot, sweep.out / "plots");
+  } else if (!convergence_rows.empty() || !value_summaries.empty()) {
+    Log().warn("sweep collect: no gnuplot found (install Debian's gnuplot-nox, or set IRBENCH_GNUPLOT): "
+               "report.html has tables but no charts");
+  }
   if (!convergence.empty()) md << "\n## Search convergence\n\n" << convergence;
   md << "\n## Points, best first\n\n" << rank_table << "\n## " << spec.metric << " by axis\n" << axis_tables;
   out.md = sweep.out / "sweep.md";
@@ -460,9 +508,16 @@ SweepCollected CollectSweep(const SweepOptions& options) {
     if (!std::holds_alternative<PlacementAxis>(spec.axes[k].axis)) continue;
     html << "<h2>Placement of " << HtmlEscape(spec.axes[k].name) << "</h2>\n" << HeatMap(spec, k, points);
   }
-  if (!convergence.empty()) html << "<h2>Search convergence</h2>\n" << MarkdownTableHtml(convergence);
+  if (!convergence.empty()) {
+    html << "<h2>Search convergence</h2>\n" << (charts.count("convergence") ? charts.at("convergence") : "")
+         << MarkdownTableHtml(convergence);
+  }
   html << "<h2>Points, best first</h2>\n" << MarkdownTableHtml(rank_table) << "<h2>" << HtmlEscape(spec.metric)
-       << " by axis</h2>\n" << MarkdownTableHtml(axis_tables) << "<h2>Each point's report, worst first</h2>\n<ul>\n";
+       << " by axis</h2>\n";
+  for (size_t i = 0; i < value_summaries.size(); ++i) {
+    if (const auto chart = charts.find("axis_" + std::to_string(i)); chart != charts.end()) html << chart->second;
+  }
+  html << MarkdownTableHtml(axis_tables) << "<h2>Each point's report, worst first</h2>\n<ul>\n";
   for (auto it = ranked.rbegin(); it != ranked.rend(); ++it) {
     if (it->report.empty()) continue;
     const std::string link = fs::relative(sweep.cache / it->report, sweep.out).generic_string();
