@@ -300,7 +300,7 @@ std::string HeatMap(const SweepSpec& spec, size_t k, const std::vector<Done>& po
     const AxisValue& at = d.point.at[k];
     const std::pair<long, long> key = spec.mode == "grid" ? std::make_pair(long(at.along_step), long(at.height_step))
                                                             : std::make_pair(long(d.index), 0L);
-    auto& [sum, n] = cells.try_emplace(key, Cell{at.along, at.height}).first->second.by_aim[{at.pan, at.tilt}];
+    auto& [sum, n] = cells.try_emplace(key, Cell{at.along, at.height, {}, 0.0, {}}).first->second.by_aim[{at.pan, at.tilt}];
     sum += it->second;
     ++n;
   }
