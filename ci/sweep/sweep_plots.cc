@@ -68,11 +68,14 @@ std::map<std::string, std::string> DrawSweepPlots(const std::string& metric, con
     const std::string name = "axis_" + std::to_string(i), file = name + ".tsv";
     AtomicWriteFile(workdir / file, data.str());
     gp << "set output \"" << name << ".svg\"\n"
-       << "set title " << GnuplotQuoted(metric + " against " + axis.name + " (mean over the other axes; bars: the points' range)")
-       << "\nset xlabel " << GnuplotQuoted(axis.name) << "\nset key off\n";
+       << "set title " << GnuplotQuoted(metric + " against " + axis.name) << "\nset xlabel " << GnuplotQuoted(axis.name)
+       << "\nset key off\n";
     if (numeric) {
-      gp << "set xtics autofreq\nset offsets graph 0.05, graph 0.05, 0, 0\n"
-         << "plot \"" << file << "\" using 2:3:4:5 with yerrorlines pt 7 lw 2 lc rgb \"#1f78b4\"\n";
+      // Values spread over a factor of 8 or more (a light level, a count) on a log scale.
+      const bool log = *rows.front().x > 0 && *rows.back().x >= 8 * *rows.front().x;
+      gp << "set xtics autofreq\nset offsets graph 0.05, graph 0.05, 0, 0\n" << (log ? "set logscale x\n" : "")
+         << "plot \"" << file << "\" using 2:3:4:5 with yerrorlines pt 7 lw 2 lc rgb \"#1f78b4\"\n"
+         << (log ? "unset logscale x\n" : "");
     } else {
       gp << "set style fill solid 0.6 border rgb \"#1f4e79\"\nset boxwidth 0.6\nset xtics rotate by -20\n"
          << "set offsets 0.5, 0.5, 0, 0\n"

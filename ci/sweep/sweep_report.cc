@@ -514,6 +514,11 @@ SweepCollected CollectSweep(const SweepOptions& options) {
   }
   html << "<h2>Points, best first</h2>\n" << MarkdownTableHtml(rank_table) << "<h2>" << HtmlEscape(spec.metric)
        << " by axis</h2>\n";
+  if (charts.size() > (charts.count("convergence") ? 1u : 0u)) {
+    html << "<p>Each chart: the metric's mean over the points at each value of the axis (over every other axis), "
+            "the bars their range. Points that measured nothing (the person never tracked) are left out; the "
+            "table above lists them with a dash.</p>\n";
+  }
   for (size_t i = 0; i < value_summaries.size(); ++i) {
     if (const auto chart = charts.find("axis_" + std::to_string(i)); chart != charts.end()) html << chart->second;
   }
