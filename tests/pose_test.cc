@@ -405,6 +405,44 @@ TEST(PoseTracker, FollowsAModelRaisingItsArmAndRecoversFromScattering) {
   EXPECT_FALSE(tracker.Step(empty, 1.0 / 30).tracking);
 }
 
+// A camera aimed so high that its image cuts off the feet of a person at the
+// stage's centre (found by sweeping the side camera's tilt: 12 degrees up
+// kept every frame "partial", nothing tracked) is left out of the in-view
+// test; the others still decide it, and the tracker tracks.
+TEST(PoseTracker, ACameraThatCutsOffThePersonAtTheCentreIsLeftOutOfTheInViewTest) {
+  std::vector<Camera> cams = PinholeRig();
+  Camera* side = nullptr;
+  for (Camera& c : cams) {
+    if (c.name == "side") side = &c;
+  }
+  ASSERT_NE(side, nullptr);
+  EXPECT_TRUE(HoldsBox(*side, Vector3d::Zero(), 2.0, 0.35));
+  // Tilted 12 degrees up about its own x axis (OpenCV frame: y down): the
+  // floor below the box, 27.8 degrees below the horizontal from 1.9 m up and
+  // 3.6 m away, leaves its 25.6-degree lower half field of view.
+  const double depression = std::atan2(side->CenterInWorld().z() - 1.0, side->CenterInWorld().head<2>().norm());
+  const double floor_angle = std::atan2(side->CenterInWorld().z(), side->CenterInWorld().head<2>().norm() - 0.35);
+  const double half_fov = std::atan2(side->height - 1 - side->cy, side->fy);
+  const double tilt = 12 * M_PI / 180;
+  ASSERT_GT(floor_angle - (depression - tilt), half_fov);  // the analytic expectation
+  side->cam_from_world = Eigen::Isometry3d(Eigen::AngleAxisd(-tilt, Vector3d::UnitX())) * side->cam_from_world;
+  EXPECT_FALSE(HoldsBox(*side, Vector3d::Zero(), 2.0, 0.35));
+  Camera turned = *side;
+  turned.cam_from_world = Eigen::Isometry3d(Eigen::AngleAxisd(M_PI, Vector3d::UnitY())) * side->cam_from_world;
+  EXPECT_FALSE(HoldsBox(turned, Vector3d::Zero(), 2.0, 0.35));  // facing away
+
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTrackerOptions options;
+  options.seed = 2;
+  PoseTracker tracker(cams, {}, options);
+  const BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.0), 0.0);
+  PoseEstimate e;
+  for (int f = 0; f < 8; ++f) e = tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30);
+  EXPECT_TRUE(e.in_view);
+  EXPECT_TRUE(e.tracking);
+  EXPECT_LT((e.body.joints[kModelRoot] - PoseBody(shape, truth).joints[kModelRoot]).norm(), 0.05);
+}
+
 // Ctrl-C is honoured within a frame's particles (issue 27): a cancel that
 // arrives while the particles are scored stops the scoring and throws
 // Cancelled in the caller, instead of finishing the whole frame.

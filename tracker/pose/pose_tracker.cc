@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "common/logging.h"
 #include "tracker/pose/internal/median.h"
 
 namespace irbench {
@@ -39,6 +40,18 @@ PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface>
     map1_.push_back(m1);
     map2_.push_back(m2);
   }
+  // A camera whose image cuts off a person standing at the stage's centre
+  // (aimed too high, too close) would keep every frame "partial": it is left
+  // out of the in-view test, with a warning. (Its silhouette still counts:
+  // the hull and the likelihood take what it sees.)
+  for (const Camera& cam : cameras_) {
+    holds_stage_.push_back(HoldsBox(cam, Vector3d::Zero(), kStageCheckHeightM, options_.view_margin_m));
+    if (!holds_stage_.back()) {
+      Log().warn("pose: camera '{}' does not hold a person standing at the stage's centre (a {:.1f} m box about (0, 0) "
+                 "reaches outside its image): it is left out of the in-view test, which it would always fail",
+                 cam.name, kStageCheckHeightM);
+    }
+  }
   // Users face the screen (thesis 1.2): the mean of the screens' centres.
   Vector2d sum = Vector2d::Zero();
   for (const ScreenSurface& s : screens_) sum += s.PointAt(s.Size() / 2).head<2>();
@@ -50,19 +63,23 @@ double PoseTracker::Evaluate(const BodyPose& pose, const std::vector<SilhouetteV
   return Evaluate(shape_, pose, views, overlaps);
 }
 
-bool PoseTracker::InView(const Eigen::Vector3d& root) const {
-  const double top = shape_.height_m;
-  for (const Camera& cam : cameras_) {
-    for (double z : {0.05, 0.5 * top, top}) {
-      for (double dx : {-options_.view_margin_m, options_.view_margin_m}) {
-        for (double dy : {-options_.view_margin_m, options_.view_margin_m}) {
-          const Vector3d p(root.x() + dx, root.y() + dy, z);
-          if ((cam.cam_from_world * p).z() <= 0.05) return false;
-          const Eigen::Vector2d px = cam.Project(p);
-          if (!(px.x() >= 0 && px.y() >= 0 && px.x() <= cam.width - 1 && px.y() <= cam.height - 1)) return false;
-        }
+bool HoldsBox(const Camera& cam, const Eigen::Vector3d& root, double height_m, double margin_m) {
+  for (double z : {0.05, 0.5 * height_m, height_m}) {
+    for (double dx : {-margin_m, margin_m}) {
+      for (double dy : {-margin_m, margin_m}) {
+        const Vector3d p(root.x() + dx, root.y() + dy, z);
+        if ((cam.cam_from_world * p).z() <= 0.05) return false;
+        const Eigen::Vector2d px = cam.Project(p);
+        if (!(px.x() >= 0 && px.y() >= 0 && px.x() <= cam.width - 1 && px.y() <= cam.height - 1)) return false;
       }
     }
+  }
+  return true;
+}
+
+bool PoseTracker::InView(const Eigen::Vector3d& root) const {
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    if (holds_stage_[c] && !HoldsBox(cameras_[c], root, shape_.height_m, options_.view_margin_m)) return false;
   }
   return true;
 }

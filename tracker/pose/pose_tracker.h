@@ -59,6 +59,11 @@ struct PoseEstimate {
 // Descriptor & Posture Recognition Function"): poses to seed particles with.
 using PoseProposalHook = std::function<std::vector<BodyPose>(const FrameFeatures&, const BodyShape&)>;
 
+// Does `camera` hold a box of half-width `margin_m` about `root` (x, y),
+// from the floor to `height_m`, inside its image (its corners in front of it
+// and on its pixels)? The pose tracker's "in view" test.
+bool HoldsBox(const Camera& camera, const Eigen::Vector3d& root, double height_m, double margin_m);
+
 class PoseTracker {
  public:
   // `screens` (as surveyed, calib/screens.json) give the pointing targets
@@ -120,7 +125,12 @@ class PoseTracker {
 
   double Evaluate(const BodyPose& pose, const std::vector<SilhouetteView>& views, std::vector<double>* overlaps) const;
   double HeadingPrior(const BodyPose& pose) const;
+  // The box HoldsBox checks, about the root, inside the image of every camera
+  // that holds it at the stage's centre (holds_stage_).
   bool InView(const Eigen::Vector3d& root) const;
+  // Per camera: does it hold a kStageCheckHeightM box at the stage's centre?
+  std::vector<bool> holds_stage_;
+  static constexpr double kStageCheckHeightM = 2.0;
   // Does the model's head centre fall inside every camera's silhouette? A
   // view that lost the head (dark hair against a dark wall) carved it from
   // the voxel hull too.
