@@ -306,7 +306,9 @@ TEST(PoseTracker, ConfiguresTheShoulderWidthFromStraightArms) {
         const bool at_rest = f < 20;
         e = tracker.Step(ModelFeatures(cams, shape, at_rest ? rest : held, f, {!at_rest, !at_rest}), 1.0 / 30);
         ASSERT_TRUE(e.tracking) << f;
-        if (at_rest) EXPECT_EQ(e.shape.shoulder_width, 1.0) << "no arm points, no measurement";
+        if (at_rest) {
+          EXPECT_EQ(e.shape.shoulder_width, 1.0) << "no arm points, no measurement";
+        }
       }
       const double expected = sideways ? 0.105 * e.shape.height_m : shape.shoulder_offset_m;
       EXPECT_NEAR(2 * e.shape.shoulder_offset_m, 2 * expected, 0.01) << width << (sideways ? " sideways" : "");
