@@ -14,9 +14,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A label for a tab-separated data file: no tabs or line breaks.
+// A label for a tab-separated data file: no tabs or line breaks, no double
+// quotes (gnuplot's string delimiter), no leading # (a comment line).
 std::string Cell(std::string text) {
   std::replace_if(text.begin(), text.end(), [](char c) { return c == '\t' || c == '\n' || c == '\r'; }, ' ');
+  std::replace(text.begin(), text.end(), '"', '\'');
+  if (!text.empty() && text[0] == '#') text[0] = '_';
   return text.empty() ? "-" : text;
 }
 

@@ -29,7 +29,7 @@ struct AxisValueSummary {
 
 struct AxisSummary {
   std::string name;  // the axis's key
-  std::vector<AxisValueSummary> values;  // in the spec's order
+  std::vector<AxisValueSummary> values;  // in the order they first appear among the measured points
 };
 
 // Writes the data, `sweep_plots.gp` and the SVGs into `workdir` (created if

@@ -143,13 +143,17 @@ void ApplyRigAxis(const std::string& key, const nlohmann::json& value, nlohmann:
   }
 }
 
-std::string RigAxisProblem(const fs::path& rig_file, const std::string& key, const nlohmann::json& value,
+std::string RigAxisProblem(const fs::path& rig_file, const std::vector<std::pair<std::string, nlohmann::json>>& values,
                            const std::vector<std::string>& presets) {
   nlohmann::json rig;
+  bool knob = false;
   try {
     std::ifstream in(rig_file);
     rig = nlohmann::json::parse(in);
-    ApplyRigAxis(key, value, &rig);
+    for (const auto& [key, value] : values) {
+      ApplyRigAxis(key, value, &rig);
+      knob |= IsSensorKnobKey(key);
+    }
   } catch (const InputError& e) {
     return e.message();
   } catch (const nlohmann::json::exception& e) {
@@ -163,7 +167,7 @@ std::string RigAxisProblem(const fs::path& rig_file, const std::string& key, con
   std::string problem;
   try {
     const Rig loaded = LoadRig(scratch);
-    for (size_t i = 0; IsSensorKnobKey(key) && i < loaded.cameras.size(); ++i) {
+    for (size_t i = 0; knob && i < loaded.cameras.size(); ++i) {
       for (const std::string& preset : presets) {
         std::optional<SensorSetup> setup = SensorPreset(preset);
         if (!setup) continue;  // an unknown preset is the `sensor` key's error

@@ -17,6 +17,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -35,12 +36,13 @@ bool IsRigAxisKey(const std::string& key);
 // a camera the rig lacks; the result is checked by LoadRig, not here.
 void ApplyRigAxis(const std::string& key, const nlohmann::json& value, nlohmann::json* rig);
 
-// The rig file's JSON with `value` applied, loaded and checked as a rig file
+// The rig file's JSON with the (key, value) pairs applied in order, loaded and checked as a rig file
 // would be (LoadRig, through a scratch file) and, for a sensor knob, each
 // camera's sensor overrides applied to each of `presets` (the sensor presets
 // a point may have) as a render would: "" or what is wrong, e.g.
 // "cameras[1].fx: focal length must be positive".
-std::string RigAxisProblem(const std::filesystem::path& rig_file, const std::string& key, const nlohmann::json& value,
+std::string RigAxisProblem(const std::filesystem::path& rig_file,
+                           const std::vector<std::pair<std::string, nlohmann::json>>& values,
                            const std::vector<std::string>& presets);
 
 }  // namespace irbench

@@ -170,18 +170,22 @@ void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& p
     }
   }
   if (!a.Has("tilt")) return;
-  // Every corner's view, tilted, stays more than 5° off the camera's up and
-  // down (a pan about the up keeps the elevation; a tilt past it would turn
-  // the camera over).
+  // Every view, tilted, stays within 85° of the horizontal (a pan about the
+  // up keeps the elevation; a tilt past it would turn the camera over). The
+  // view is steepest at the line's ends or where it passes nearest look_at.
   nlohmann::json rig_camera;
   {
     std::ifstream in(place.rig_file);
-    for (const nlohmann::json& c : nlohmann::json::parse(in)["cameras"]) {
+    const nlohmann::json rig = nlohmann::json::parse(in);
+    for (const nlohmann::json& c : rig["cameras"]) {
       if (c.value("name", "") == p.camera) rig_camera = c;
     }
   }
   const Eigen::Vector3d up = PlacedUp(p, rig_camera).normalized();
-  for (const double along : {0.0, 1.0}) {
+  const Eigen::Vector2d line = p.to - p.from;
+  const double nearest =
+      line.squaredNorm() > 0 ? std::clamp((p.look_at.head<2>() - p.from).dot(line) / line.squaredNorm(), 0.0, 1.0) : 0.0;
+  for (const double along : {0.0, 1.0, nearest}) {
     for (const double height : {p.height.from, p.height.to}) {
       const Eigen::Vector3d at = PlacementPosition(p, along, height);
       const double elevation = std::asin(std::clamp((p.look_at - at).normalized().dot(up), -1.0, 1.0)) * 180 / M_PI;
@@ -216,13 +220,40 @@ void CheckRigAxes(const SweepSpec& spec, const std::vector<RigAxisAt>& rig_axes,
       if (value.is_string()) presets.push_back(value.get<std::string>());
     }
   }
+  std::vector<fs::path> rig_files;
+  for (const nlohmann::json& rig : rigs) {
+    rig_files.push_back(PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), spec.file)).rig_file);
+  }
+  std::vector<const RigAxisAt*> knobs;
   for (const RigAxisAt& at : rig_axes) {
-    for (const nlohmann::json& rig : rigs) {
-      const fs::path rig_file = PlaceOf(ScenarioOf(WithValue(spec.base, "rig", rig), spec.file)).rig_file;
+    if (IsSensorKnobKey(at.axis.key)) knobs.push_back(&at);
+    for (const fs::path& rig_file : rig_files) {
       for (size_t j = 0; j < at.axis.values.size(); ++j) {
-        if (const std::string problem = RigAxisProblem(rig_file, at.axis.key, at.axis.values[j], presets); !problem.empty()) {
+        if (const std::string problem = RigAxisProblem(rig_file, {{at.axis.key, at.axis.values[j]}}, presets);
+            !problem.empty()) {
           at.node["values"][j].Fail(problem);
         }
+      }
+    }
+  }
+  // Knobs bound to each other (tone_lift + tone_ceiling_drop, black_level_dn
+  // and bit_depth): every combination of the knob axes' values, up to 256.
+  size_t combinations = knobs.size() > 1 ? 1 : 0;
+  for (const RigAxisAt* at : knobs) combinations = std::min<size_t>(combinations * at->axis.values.size(), 257);
+  if (combinations == 0 || combinations > 256) return;
+  for (size_t c = 0; c < combinations; ++c) {
+    std::vector<std::pair<std::string, nlohmann::json>> values;
+    std::string with;
+    size_t rest = c, last_j = 0;
+    for (const RigAxisAt* at : knobs) {
+      last_j = rest % at->axis.values.size();
+      rest /= at->axis.values.size();
+      values.emplace_back(at->axis.key, at->axis.values[last_j]);
+      if (at != knobs.back()) with += (with.empty() ? "" : ", ") + at->axis.key + " " + at->axis.values[last_j].dump();
+    }
+    for (const fs::path& rig_file : rig_files) {
+      if (const std::string problem = RigAxisProblem(rig_file, values, presets); !problem.empty()) {
+        knobs.back()->node["values"][last_j].Fail("with " + with + ": " + problem);
       }
     }
   }
@@ -277,7 +308,8 @@ double Normal(uint64_t seed, int index, size_t dim) {
 }
 
 // The cross-entropy method's sampling distribution, per unit coordinate
-// (each placement: along 0..1, height 0..1 from `from` to `to`).
+// (each placement: along 0..1, height 0..1 from `from` to `to`, and with aim
+// ranges pan and tilt 0..1 likewise; each pose dimension 0..1 over its range).
 struct Gaussian {
   std::vector<double> mean, sigma;
   // Point `index`'s unit coordinates: the mean itself, or drawn and clipped.

@@ -141,7 +141,7 @@ SweepPoint PointAt(const SweepSpec& spec, int index, const PointMetric& metric_o
 
 // {"<camera>.along": .., "<camera>.height": .., "<camera>.position": [x,y,z],
 // (a placement with aim ranges) "<camera>.pan": .., "<camera>.tilt": ..,
-// "<camera>.look_at": [x,y,z], "<key>": value, ...}
+// "<key>": value, ...}
 nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point);
 
 // The point's scenario: the base with the point's values; a placement writes

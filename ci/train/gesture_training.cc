@@ -313,7 +313,7 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
                         }()},
                        {"tracks", [&] {
                           nlohmann::json a = nlohmann::json::object();
-                          for (const fs::path& p : job.train) a[p.filename().string()] = result.tracks.at(p.filename().string());
+                          for (size_t i = 0; i < job.train.size(); ++i) a[job.train[i].filename().string()] = train[i].track;
                           return a;
                         }()},
                        {"segments", result.segments},

@@ -46,10 +46,16 @@ PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface>
   // the hull and the likelihood take what it sees.)
   for (const Camera& cam : cameras_) {
     holds_stage_.push_back(HoldsBox(cam, Vector3d::Zero(), kStageCheckHeightM, options_.view_margin_m));
-    if (!holds_stage_.back()) {
+  }
+  if (std::none_of(holds_stage_.begin(), holds_stage_.end(), [](bool holds) { return holds; })) {
+    // No camera holds the centre: the stage lies elsewhere; every camera decides.
+    holds_stage_.assign(cameras_.size(), true);
+  }
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    if (!holds_stage_[c]) {
       Log().warn("pose: camera '{}' does not hold a person standing at the stage's centre (a {:.1f} m box about (0, 0) "
                  "reaches outside its image): it is left out of the in-view test, which it would always fail",
-                 cam.name, kStageCheckHeightM);
+                 cameras_[c].name, kStageCheckHeightM);
     }
   }
   // Users face the screen (thesis 1.2): the mean of the screens' centres.
