@@ -96,6 +96,20 @@ void RunGnuplot(const fs::path& gnuplot, const fs::path& workdir, const std::str
   }
 }
 
+std::map<std::string, std::string> DrawGnuplotSvgs(const fs::path& gnuplot, const fs::path& workdir,
+                                                   const std::string& script_file, const std::string& script,
+                                                   const std::vector<std::string>& names) {
+  AtomicWriteFile(workdir / script_file, script);
+  RunGnuplot(gnuplot, workdir, script_file);
+  std::map<std::string, std::string> svgs;
+  for (const std::string& name : names) {
+    const fs::path file = workdir / (name + ".svg");
+    if (!fs::is_regular_file(file)) throw RuntimeError("gnuplot wrote no " + file.string());
+    svgs[name] = ReadFileBytes(file);
+  }
+  return svgs;
+}
+
 std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::path& gnuplot,
                                                   const fs::path& workdir) {
   fs::create_directories(workdir);
@@ -201,15 +215,7 @@ std::map<std::string, std::string> DrawScorePlots(const Score& score, const fs::
     names.push_back("silhouettes_over_time");
   }
 
-  AtomicWriteFile(workdir / "plots.gp", gp.str());
-  RunGnuplot(gnuplot, workdir, "plots.gp");
-  std::map<std::string, std::string> svgs;
-  for (const std::string& name : names) {
-    const fs::path file = workdir / (name + ".svg");
-    if (!fs::is_regular_file(file)) throw RuntimeError("gnuplot wrote no " + file.string());
-    svgs[name] = ReadFileBytes(file);
-  }
-  return svgs;
+  return DrawGnuplotSvgs(gnuplot, workdir, "plots.gp", gp.str(), names);
 }
 
 }  // namespace irbench

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "ci/score/score.h"
 
@@ -23,6 +24,13 @@ std::string GnuplotQuoted(const std::string& s);
 // gnuplot printed when it fails.
 void RunGnuplot(const std::filesystem::path& gnuplot, const std::filesystem::path& workdir,
                 const std::string& script_file);
+
+// Writes `script` to workdir/script_file, runs it (RunGnuplot) and returns
+// name -> the text of workdir/<name>.svg for each of `names`; RuntimeError
+// when gnuplot fails or leaves one of them unwritten.
+std::map<std::string, std::string> DrawGnuplotSvgs(const std::filesystem::path& gnuplot,
+                                                   const std::filesystem::path& workdir, const std::string& script_file,
+                                                   const std::string& script, const std::vector<std::string>& names);
 
 // Draws the score's plots with `gnuplot` in `workdir` (created if needed):
 // returns plot name -> SVG text for "joint_histograms" (Fig. 6.8: one panel

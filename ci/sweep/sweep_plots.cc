@@ -5,8 +5,6 @@
 
 #include "ci/report/plots.h"
 #include "common/atomic_file.h"
-#include "common/error.h"
-#include "common/file_bytes.h"
 
 namespace irbench {
 
@@ -89,15 +87,7 @@ std::map<std::string, std::string> DrawSweepPlots(const std::string& metric, con
     gp << "set offsets 0, 0, 0, 0\n";
     names.push_back(name);
   }
-  AtomicWriteFile(workdir / "sweep_plots.gp", gp.str());
-  RunGnuplot(gnuplot, workdir, "sweep_plots.gp");
-  std::map<std::string, std::string> svgs;
-  for (const std::string& name : names) {
-    const fs::path file = workdir / (name + ".svg");
-    if (!fs::is_regular_file(file)) throw RuntimeError("gnuplot wrote no " + file.string());
-    svgs[name] = ReadFileBytes(file);
-  }
-  return svgs;
+  return DrawGnuplotSvgs(gnuplot, workdir, "sweep_plots.gp", gp.str(), names);
 }
 
 }  // namespace irbench
