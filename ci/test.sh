@@ -14,14 +14,21 @@ cmake --build build -j"$(nproc)"
 # The sanitizer build (clang, build-san/) at the lowest priority beside the
 # Release tests: it takes only the CPU time the tests leave idle, so they keep
 # their pace, and it goes on at full speed once they are done. Its log is
-# printed when it ends.
-SANITIZE_STEPS=build setsid nice -n 19 ./ci/sanitize.sh >build/sanitize-build.log 2>&1 &
+# printed when it ends. (It stays in this session: with the kernel's
+# autogroup scheduling, a process in a session of its own, setsid, would
+# share the CPU equally with the tests whatever its nice value.)
+SANITIZE_STEPS=build nice -n 19 ./ci/sanitize.sh >build/sanitize-build.log 2>&1 &
 san_build=$!
+kill_tree() {
+  local child
+  for child in $(pgrep -P "$1" || true); do kill_tree "$child"; done
+  kill "$1" 2>/dev/null || true
+}
 # One test more than there are cores: the closed-loop tests wait on their
 # subprocesses, files and the Slurm daemons part of the time (on 2 cores, 612 s
 # instead of 663 s for the same tests).
 if ! ctest --test-dir build --output-on-failure -j"$(($(nproc) + 1))"; then
-  kill -- -"$san_build" 2>/dev/null || true
+  kill_tree "$san_build"
   wait "$san_build" || true
   exit 1
 fi
