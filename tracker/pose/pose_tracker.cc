@@ -97,6 +97,18 @@ Vector2d PoseTracker::Preferred() const {
   return facing_xy_;
 }
 
+bool PoseTracker::IsStep(const Eigen::Vector2d& velocity_xy) const {
+  // A slow move that the feet, planted and clearly pointing, do not follow
+  // is a step to the side or back (people shuffle, step back, sway while
+  // they gesture), not a walk: the feet keep the heading. During a real
+  // walk the feet's average is short (the floor layer alternates between
+  // one foot's heel and the other's toes), so it does not veto the walk.
+  if (!options_.heading_from_feet || velocity_xy.norm() >= options_.step_max_speed_mps) return false;
+  if (feet_toes_.norm() < std::max(options_.feet_min_m, 1e-6)) return false;
+  const double cos_angle = feet_toes_.normalized().dot(velocity_xy.normalized());
+  return cos_angle < std::cos(options_.step_feet_angle_deg * M_PI / 180);
+}
+
 void PoseTracker::MeasureLegs(const FrameFeatures& features, double dt, PoseEstimate* out) {
   if (!out->tracking || !features.voxels) return;
   const auto legs = MeasureHullLegs(*features.voxels, out->body.joints[kModelRoot],
@@ -245,6 +257,7 @@ void PoseTracker::UpdateWalking(const Eigen::Vector2d& root_xy, double dt) {
         ahead += (recent_roots_[i + 3] - recent_roots_[i]).dot(dir) > 0.01;
       }
       steady = steps > 0 && ahead >= 0.75 * steps;
+      if (steady && IsStep(velocity_xy_)) steady = false;
     }
     moving_frames_ = steady ? moving_frames_ + 1 : 0;
     walking_ = moving_frames_ >= 2;

@@ -153,6 +153,10 @@ class PoseTracker {
   // The direction a standing user is taken to face: the feet's when they
   // show it (heading_from_feet), else the screens'.
   Eigen::Vector2d Preferred() const;
+  // A move at `velocity_xy` that is a step, not a walk: slower than
+  // step_max_speed_mps and more than step_feet_angle_deg away from where the
+  // averaged feet point (when they show it).
+  bool IsStep(const Eigen::Vector2d& velocity_xy) const;
   // The root from the hull's legs (root_from_hull) and the feet's direction.
   void MeasureLegs(const FrameFeatures& features, double dt, PoseEstimate* out);
 

@@ -50,6 +50,9 @@ void PoseTrackerOptions::Check() const {
   hull_legs.Check();
   if (!(feet_memory_s > 0)) throw InputError("", "pose.feet_memory_s", "must be positive");
   if (!(feet_min_m >= 0)) throw InputError("", "pose.feet_min_m", "must be non-negative");
+  if (!(step_max_speed_mps >= 0)) throw InputError("", "pose.step_max_speed_mps", "must be non-negative");
+  if (!(step_feet_angle_deg >= 0 && step_feet_angle_deg <= 180))
+    throw InputError("", "pose.step_feet_angle_deg", "must be in [0, 180]");
   if (height_frames < 1) throw InputError("", "pose.height_frames", "must be at least 1");
   if (arm_thickness_frames < 0)
     throw InputError("", "pose.arm_thickness_frames", "must be non-negative");
