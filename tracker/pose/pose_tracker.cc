@@ -90,10 +90,12 @@ bool PoseTracker::InView(const Eigen::Vector3d& root) const {
   return true;
 }
 
+bool PoseTracker::FeetShowHeading() const {
+  return options_.heading_from_feet && feet_toes_.norm() >= std::max(options_.feet_min_m, 1e-6);
+}
+
 Vector2d PoseTracker::Preferred() const {
-  if (options_.heading_from_feet && feet_toes_.norm() >= std::max(options_.feet_min_m, 1e-6)) {
-    return feet_toes_.normalized();
-  }
+  if (FeetShowHeading()) return feet_toes_.normalized();
   return facing_xy_;
 }
 
@@ -103,8 +105,7 @@ bool PoseTracker::IsStep(const Eigen::Vector2d& velocity_xy) const {
   // they gesture), not a walk: the feet keep the heading. During a real
   // walk the feet's average is short (the floor layer alternates between
   // one foot's heel and the other's toes), so it does not veto the walk.
-  if (!options_.heading_from_feet || velocity_xy.norm() >= options_.step_max_speed_mps) return false;
-  if (feet_toes_.norm() < std::max(options_.feet_min_m, 1e-6)) return false;
+  if (!FeetShowHeading() || velocity_xy.norm() >= options_.step_max_speed_mps) return false;
   const double cos_angle = feet_toes_.normalized().dot(velocity_xy.normalized());
   return cos_angle < std::cos(options_.step_feet_angle_deg * M_PI / 180);
 }

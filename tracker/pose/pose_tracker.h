@@ -150,8 +150,11 @@ class PoseTracker {
   // The feet's direction (HullLegs::toes), averaged over feet_memory_s; zero
   // before the feet are seen.
   Eigen::Vector2d feet_toes_ = Eigen::Vector2d::Zero();
+  // The feet's average shows a heading: heading_from_feet, and it reaches
+  // feet_min_m.
+  bool FeetShowHeading() const;
   // The direction a standing user is taken to face: the feet's when they
-  // show it (heading_from_feet), else the screens'.
+  // show it (FeetShowHeading), else the screens'.
   Eigen::Vector2d Preferred() const;
   // A move at `velocity_xy` that is a step, not a walk: slower than
   // step_max_speed_mps and more than step_feet_angle_deg away from where the
