@@ -6,7 +6,10 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <set>
+#include <string>
+#include <utility>
 
 #include "common/error.h"
 #include "sim/camera/rig.h"
@@ -97,11 +100,22 @@ void Distort(const nlohmann::json& value, nlohmann::json* rig) {
   for (nlohmann::json& c : (*rig)["cameras"]) c["dist"] = value;
 }
 
+// `sensor.<group>.<knob>` split into (group, knob); nullopt for any other key.
+std::optional<std::pair<std::string, std::string>> SensorKnob(const std::string& key) {
+  const std::string prefix = "sensor.";
+  if (key.rfind(prefix, 0) != 0) return std::nullopt;
+  const size_t dot = key.find('.', prefix.size());
+  if (dot == std::string::npos || dot == prefix.size() || dot + 1 == key.size() ||
+      key.find('.', dot + 1) != std::string::npos) {
+    return std::nullopt;
+  }
+  return std::make_pair(key.substr(prefix.size(), dot - prefix.size()), key.substr(dot + 1));
+}
+
 // Every camera's override of the knob `sensor.<group>.<knob>` set to the value.
 void SetKnob(const std::string& key, const nlohmann::json& value, nlohmann::json* rig) {
   if (!value.is_number() && !value.is_boolean()) Bad("a sensor knob takes a number or true/false");
-  const size_t dot = key.find('.', 7);
-  const std::string group = key.substr(7, dot - 7), knob = key.substr(dot + 1);
+  const auto [group, knob] = *SensorKnob(key);
   for (nlohmann::json& c : (*rig)["cameras"]) {
     if (!c.contains("sensor") || !c["sensor"].is_object()) c["sensor"] = nlohmann::json::object();
     if (!c["sensor"].contains(group) || !c["sensor"][group].is_object()) c["sensor"][group] = nlohmann::json::object();
@@ -111,11 +125,7 @@ void SetKnob(const std::string& key, const nlohmann::json& value, nlohmann::json
 
 }  // namespace
 
-bool IsSensorKnobKey(const std::string& key) {
-  if (key.rfind("sensor.", 0) != 0) return false;
-  const size_t dot = key.find('.', 7);
-  return dot != std::string::npos && dot > 7 && dot + 1 < key.size() && key.find('.', dot + 1) == std::string::npos;
-}
+bool IsSensorKnobKey(const std::string& key) { return SensorKnob(key).has_value(); }
 
 const std::vector<std::string>& RigAxisKeys() {
   static const std::vector<std::string> keys = {"rig.cameras", "rig.resolution", "rig.focal_scale", "rig.dist"};
