@@ -51,13 +51,24 @@ std::optional<double> BodyCalibration::MatchHullTop(double top_m, BodyShape* sha
 std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking,
                                                              const BodyPose& estimate,
                                                              double top_m,
+                                                             bool feet_on_floor,
                                                              const ShapeScore& score,
                                                              BodyShape* shape) {
   const PosedBody body = PoseBody(*shape, estimate);
   const bool arms_low =
       body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
       body.joints[kModelLeftHandTip].z() < body.joints[kModelLeftShoulder].z();
-  if (tracking && arms_low && static_cast<int>(heights_.size()) < options_.height_frames) {
+  // The hull's top is the user's height only while they stand up straight:
+  // not bent (the trunk's lean), not crouched (the waist low for the top:
+  // a crouch lowers both by as much, a model too tall or too short has its
+  // waist where the silhouettes put it, and the fraction of the height at
+  // the waist is the model's), not jumping (the feet on the floor).
+  const Eigen::Vector3d trunk = body.joints[kModelNeck] - body.joints[kModelWaist];
+  const double waist_for_top = std::clamp(top_m, 1.2, 2.2) * shape->waist_height_m / shape->height_m;
+  const bool upright = trunk.z() > trunk.norm() * std::cos(options_.height_max_lean_deg * M_PI / 180) &&
+                       estimate.dof[kDofZ] >= options_.height_min_waist * waist_for_top;
+  if (tracking && arms_low && upright && feet_on_floor &&
+      static_cast<int>(heights_.size()) < options_.height_frames) {
     // Searched with the torso and head upright: a twisted torso is how a
     // too-narrow model covers a wide body. The girth reaches 2.4: capped
     // at 1.5, the heavy p3 (who takes 1.65-2.0) kept a torso too narrow,

@@ -49,6 +49,8 @@ class BodyCalibration {
 
   // Has a height been measured (MeasureHeightAndGirth) since Start?
   bool height_measured() const { return !heights_.empty(); }
+  // Does MeasureHeightAndGirth still take measurements?
+  bool measuring_height() const { return static_cast<int>(heights_.size()) < options_.height_frames; }
 
   // Until the height is measured, a model more than 10 % off the hull's top
   // `top_m` (metres, clamped to 1.2-2.2) takes the top's height: updates
@@ -58,13 +60,18 @@ class BodyCalibration {
 
   // Thesis 6.1.2: one frame's measurement of the height (the hull's top
   // `top_m`, metres) and the girth (the best against the silhouettes by
-  // `score`, the estimate `estimate` upright) while `tracking` and the
-  // estimate's arms are below its shoulders, over the first height_frames
-  // such frames. Updates `shape` to the medians and returns the ratio by
-  // which the waist heights scale; nullopt when nothing was measured.
+  // `score`, the estimate `estimate` upright) while `tracking`, the
+  // estimate's arms are below its shoulders, it stands upright (its trunk
+  // within height_max_lean_deg of the vertical, its waist at least
+  // height_min_waist of a standing model's as tall as `top_m`) and
+  // `feet_on_floor`, over the
+  // first height_frames such frames. Updates `shape` to the medians and
+  // returns the ratio by which the waist heights scale; nullopt when
+  // nothing was measured.
   std::optional<double> MeasureHeightAndGirth(bool tracking,
                                               const BodyPose& estimate,
                                               double top_m,
+                                              bool feet_on_floor,
                                               const ShapeScore& score,
                                               BodyShape* shape);
 

@@ -93,4 +93,23 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   return out;
 }
 
+bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
+                 const HullLegsOptions& options) {
+  if (hull.voxel_size_m <= 0) return false;
+  const double top = options.feet * height_m;
+  const double r2 = options.radius_m * options.radius_m;
+  int count = 0;
+  for (int z = 0; z < hull.nz; ++z) {
+    if (hull.VoxelCenter(0, 0, z).z() >= top) break;
+    for (int y = 0; y < hull.ny; ++y) {
+      for (int x = 0; x < hull.nx; ++x) {
+        if (!hull.Occupied(x, y, z)) continue;
+        if ((hull.VoxelCenter(x, y, z).head<2>() - root.head<2>()).squaredNorm() > r2) continue;
+        if (++count >= options.min_feet_voxels) return true;
+      }
+    }
+  }
+  return false;
+}
+
 }  // namespace irbench

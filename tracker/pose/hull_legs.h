@@ -86,4 +86,10 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
                                         const Eigen::Vector3d& forward, double height_m,
                                         const HullLegsOptions& options = {});
 
+// Are the feet on the floor: at least min_feet_voxels occupied voxels of
+// the floor layer (centres below `feet` of the height `height_m`) within
+// radius_m of `root` (horizontally)? A jump empties the floor layer.
+bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
+                 const HullLegsOptions& options = {});
+
 }  // namespace irbench

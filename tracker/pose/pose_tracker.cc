@@ -351,8 +351,13 @@ void PoseTracker::Calibrate(const FrameFeatures& features, const std::vector<Sil
   const BodyCalibration::ShapeScore score = [&](const BodyShape& shape, const BodyPose& pose) {
     return Evaluate(shape, pose, views, nullptr);
   };
-  if (const std::optional<double> ratio =
-          calibration_.MeasureHeightAndGirth(out->tracking, out->pose, features.placement->top_m, score, &shape_)) {
+  // Without a voxel hull (the front end's placement alone) the feet are
+  // taken to be on the floor.
+  const bool feet_on_floor = !calibration_.measuring_height() || !features.voxels ||
+                             FeetOnFloor(*features.voxels, PoseBody(shape_, out->pose).joints[kModelRoot],
+                                         shape_.height_m, options_.hull_legs);
+  if (const std::optional<double> ratio = calibration_.MeasureHeightAndGirth(
+          out->tracking, out->pose, features.placement->top_m, feet_on_floor, score, &shape_)) {
     for (BodyPose& p : *proposed) p.dof[kDofZ] *= *ratio;
     for (BodyPose& p : particles_) p.dof[kDofZ] *= *ratio;
     out->pose.dof[kDofZ] *= *ratio;

@@ -54,6 +54,10 @@ void PoseTrackerOptions::Check() const {
   if (!(step_feet_angle_deg >= 0 && step_feet_angle_deg <= 180))
     throw InputError("", "pose.step_feet_angle_deg", "must be in [0, 180]");
   if (height_frames < 1) throw InputError("", "pose.height_frames", "must be at least 1");
+  if (!(height_max_lean_deg > 0 && height_max_lean_deg <= 90))
+    throw InputError("", "pose.height_max_lean_deg", "must be in (0, 90]");
+  if (!(height_min_waist >= 0 && height_min_waist <= 1))
+    throw InputError("", "pose.height_min_waist", "must be in [0, 1]");
   if (arm_thickness_frames < 0)
     throw InputError("", "pose.arm_thickness_frames", "must be non-negative");
   if (arm_thickness_min_points < 1)

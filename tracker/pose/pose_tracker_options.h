@@ -133,8 +133,15 @@ struct PoseTrackerOptions {
   double view_margin_m = 0.35;
   // Frames over which the height and girth are estimated after a user
   // enters (medians of per-frame values, while the arms are below the
-  // shoulders).
+  // shoulders, the estimate stands upright and the feet are on the floor).
+  // Upright: the estimate's trunk (waist to neck) within height_max_lean_deg
+  // of the vertical and its waist at least height_min_waist of where a
+  // standing user as tall as the hull's top has it. Real people bend, crouch and jump in their first half second
+  // (CMU 13_14 laughs bent forward, 02_04 crouches to jump): taken then, the
+  // hull's top made p1 (1.75 m) 1.62 and 1.50 m tall.
   int height_frames = 15;
+  double height_max_lean_deg = 12;
+  double height_min_waist = 0.97;
   // Arm thickness (BodyShape::arm_thickness) from the 3D arm axis points'
   // diameters: their median over the first arm_thickness_frames tracked
   // frames that have arm points (0 turns the measurement off), once
