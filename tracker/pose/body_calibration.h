@@ -64,10 +64,9 @@ class BodyCalibration {
   // estimate's arms are below its shoulders, it stands upright (its trunk
   // within height_max_lean_deg of the vertical, its waist at least
   // height_min_waist of a standing model's as tall as `top_m`) and
-  // `feet_on_floor`, over the
-  // first height_frames such frames. Updates `shape` to the medians and
-  // returns the ratio by which the waist heights scale; nullopt when
-  // nothing was measured.
+  // `feet_on_floor`, over the first height_frames such frames. Updates
+  // `shape` to the medians and returns the ratio by which the waist heights
+  // scale; nullopt when nothing was measured.
   std::optional<double> MeasureHeightAndGirth(bool tracking,
                                               const BodyPose& estimate,
                                               double top_m,

@@ -353,7 +353,7 @@ void PoseTracker::Calibrate(const FrameFeatures& features, const std::vector<Sil
   };
   // Without a voxel hull (the front end's placement alone) the feet are
   // taken to be on the floor.
-  const bool feet_on_floor = !calibration_.measuring_height() || !features.voxels ||
+  const bool feet_on_floor = !out->tracking || !calibration_.measuring_height() || !features.voxels ||
                              FeetOnFloor(*features.voxels, PoseBody(shape_, out->pose).joints[kModelRoot],
                                          shape_.height_m, options_.hull_legs);
   if (const std::optional<double> ratio = calibration_.MeasureHeightAndGirth(
