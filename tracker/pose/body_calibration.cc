@@ -17,6 +17,7 @@ using pose_internal::Median;
 BodyShape BodyCalibration::Start(double top_m) {
   heights_.clear();
   girths_.clear();
+  partial_views_ = false;
   shoulder_offsets_.clear();
   shoulder_width_ = 1.0;
   arm_diameters_.clear();
@@ -52,6 +53,7 @@ std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking,
                                                              const BodyPose& estimate,
                                                              double top_m,
                                                              bool feet_on_floor,
+                                                             bool all_views,
                                                              const ShapeScore& score,
                                                              BodyShape* shape) {
   const PosedBody body = PoseBody(*shape, estimate);
@@ -67,8 +69,19 @@ std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking,
   const double waist_for_top = std::clamp(top_m, 1.2, 2.2) * shape->waist_height_m / shape->height_m;
   const bool upright = trunk.z() > trunk.norm() * std::cos(options_.height_max_lean_deg * M_PI / 180) &&
                        estimate.dof[kDofZ] >= options_.height_min_waist * waist_for_top;
-  if (tracking && arms_low && upright && feet_on_floor &&
-      static_cast<int>(heights_.size()) < options_.height_frames) {
+  if (!tracking || !arms_low || !upright || !feet_on_floor) return std::nullopt;
+  // With a camera left out the hull is carved by fewer views and its top
+  // stands higher (CameraFaultTest: the side camera dark as p3 walks in, the
+  // top 1.92 m where all four views give 1.88): such measurements stand in
+  // only until the first with all views.
+  if (all_views && partial_views_) {
+    heights_.clear();
+    girths_.clear();
+    partial_views_ = false;
+  }
+  if (!all_views && !heights_.empty() && !partial_views_) return std::nullopt;
+  if (!all_views) partial_views_ = true;
+  if (static_cast<int>(heights_.size()) < options_.height_frames) {
     // Searched with the torso and head upright: a twisted torso is how a
     // too-narrow model covers a wide body. The girth reaches 2.4: capped
     // at 1.5, the heavy p3 (who takes 1.65-2.0) kept a torso too narrow,

@@ -49,8 +49,11 @@ class BodyCalibration {
 
   // Has a height been measured (MeasureHeightAndGirth) since Start?
   bool height_measured() const { return !heights_.empty(); }
-  // Does MeasureHeightAndGirth still take measurements?
-  bool measuring_height() const { return static_cast<int>(heights_.size()) < options_.height_frames; }
+  // Does MeasureHeightAndGirth still take measurements? Until height_frames
+  // are in, and while the ones in were taken with cameras left out.
+  bool measuring_height() const {
+    return static_cast<int>(heights_.size()) < options_.height_frames || partial_views_;
+  }
 
   // Until the height is measured, a model more than 10 % off the hull's top
   // `top_m` (metres, clamped to 1.2-2.2) takes the top's height: updates
@@ -66,11 +69,16 @@ class BodyCalibration {
   // height_min_waist of a standing model's as tall as `top_m`) and
   // `feet_on_floor`, over the first height_frames such frames. Updates
   // `shape` to the medians and returns the ratio by which the waist heights
-  // scale; nullopt when nothing was measured.
+  // scale; nullopt when nothing was measured. Unless `all_views` (a camera
+  // was left out of the frame-set: its hull, carved by fewer views, stands
+  // taller) the measurement is provisional: taken only while there are no
+  // others, and all of them dropped at the first frame measured with all
+  // views, from which the height_frames are counted again.
   std::optional<double> MeasureHeightAndGirth(bool tracking,
                                               const BodyPose& estimate,
                                               double top_m,
                                               bool feet_on_floor,
+                                              bool all_views,
                                               const ShapeScore& score,
                                               BodyShape* shape);
 
@@ -101,6 +109,7 @@ class BodyCalibration {
  private:
   PoseTrackerOptions options_;
   std::vector<double> heights_, girths_;
+  bool partial_views_ = false;  // heights_ were measured with cameras left out
   std::vector<double> shoulder_offsets_;  // metres from the midline, per measurement
   double shoulder_width_ = 1.0;           // their median over the fixed proportion; 1 until measured
   std::vector<double> arm_diameters_;  // metres, from the 3D arm axis points

@@ -357,7 +357,8 @@ void PoseTracker::Calibrate(const FrameFeatures& features, const std::vector<Sil
                              FeetOnFloor(*features.voxels, PoseBody(shape_, out->pose).joints[kModelRoot],
                                          shape_.height_m, options_.hull_legs);
   if (const std::optional<double> ratio = calibration_.MeasureHeightAndGirth(
-          out->tracking, out->pose, features.placement->top_m, feet_on_floor, score, &shape_)) {
+          out->tracking, out->pose, features.placement->top_m, feet_on_floor,
+          features.UsableCameras() == static_cast<int>(features.cameras.size()), score, &shape_)) {
     for (BodyPose& p : *proposed) p.dof[kDofZ] *= *ratio;
     for (BodyPose& p : particles_) p.dof[kDofZ] *= *ratio;
     out->pose.dof[kDofZ] *= *ratio;
