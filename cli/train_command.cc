@@ -32,6 +32,12 @@ int RunTrainRest(const CLI::App& cmd, TrainRestArgs& args) {
   std::cout << "rest-state SVM: " << r.samples << " arm samples (" << r.at_rest << " at rest), "
             << train_rest.folds << "-fold cross-validated accuracy " << r.cv_accuracy * 100 << "%\n"
             << r.model.string() << "\n";
+  if (r.test_samples > 0) {
+    const size_t motions = train_rest.test_motions.size(), avatars = train_rest.test_avatars.size();
+    std::cout << "held out: " << r.test_samples << " arm samples (" << r.test_at_rest << " at rest) of " << motions
+              << (motions == 1 ? " motion" : " motions") << " on " << avatars << (avatars == 1 ? " avatar" : " avatars")
+              << ", accuracy " << r.test_accuracy * 100 << "%\n";
+  }
   return kExitOk;
 }
 
@@ -177,6 +183,10 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
       "by k-fold cross-validation, from library motions played on avatars (no rendering)");
   cmd->add_option("--avatars", train_rest.avatars, "avatars to sample")->capture_default_str();
   cmd->add_option("--motions", train_rest.motions, "library motions or motion files")
+      ->capture_default_str();
+  cmd->add_option("--test-motions", train_rest.test_motions,
+                  "held-out motions the trained SVM is scored on (none trained on)");
+  cmd->add_option("--test-avatars", train_rest.test_avatars, "avatars that play the held-out motions")
       ->capture_default_str();
   cmd->add_option("--fps", train_rest.sample_fps, "samples per second of motion")
       ->capture_default_str();
