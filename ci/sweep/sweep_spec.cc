@@ -140,12 +140,11 @@ std::string Vec(const Eigen::Vector3d& v) {
   return buf;
 }
 
-// The up a placed camera keeps: the placement's, else the rig file's for it
-// (LoadRig's default: +z).
-Eigen::Vector3d PlacedUp(const PlacementAxis& p, const nlohmann::json& rig_camera) {
+// The up a placed camera keeps: the placement's, else the rig's for it.
+Eigen::Vector3d PlacedUp(const PlacementAxis& p, const Rig& rig) {
   if (p.has_up) return p.up;
-  if (rig_camera.contains("up") && rig_camera["up"].is_array() && rig_camera["up"].size() == 3) {
-    return {rig_camera["up"][0].get<double>(), rig_camera["up"][1].get<double>(), rig_camera["up"][2].get<double>()};
+  for (size_t i = 0; i < rig.cameras.size(); ++i) {
+    if (rig.cameras[i].name == p.camera) return rig.up[i];
   }
   return Eigen::Vector3d(0, 0, 1);
 }
@@ -173,15 +172,7 @@ void CheckPlacement(const JsonNode& a, const PlacementAxis& p, const RigPlace& p
   // Every view, tilted, stays within 85° of the horizontal (a pan about the
   // up keeps the elevation; a tilt past it would turn the camera over). The
   // view is steepest at the line's ends or where it passes nearest look_at.
-  nlohmann::json rig_camera;
-  {
-    std::ifstream in(place.rig_file);
-    const nlohmann::json rig = nlohmann::json::parse(in);
-    for (const nlohmann::json& c : rig["cameras"]) {
-      if (c.value("name", "") == p.camera) rig_camera = c;
-    }
-  }
-  const Eigen::Vector3d up = PlacedUp(p, rig_camera).normalized();
+  const Eigen::Vector3d up = PlacedUp(p, place.rig).normalized();
   const Eigen::Vector2d line = p.to - p.from;
   const double nearest =
       line.squaredNorm() > 0 ? std::clamp((p.look_at.head<2>() - p.from).dot(line) / line.squaredNorm(), 0.0, 1.0) : 0.0;
@@ -652,7 +643,8 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
   if (moved) {
     // The point's rig: the base rig's file with the placed cameras moved.
     const Scenario unmoved = ScenarioOf(keys, spec.file);
-    const fs::path rig_file = LoadRenderInputs(unmoved.render).rig_file;
+    const RenderInputs unmoved_inputs = LoadRenderInputs(unmoved.render);
+    const fs::path& rig_file = unmoved_inputs.rig_file;
     std::ifstream in(rig_file);
     nlohmann::json rig = nlohmann::json::parse(in);
     rig["name"] = rig.value("name", rig_file.stem().string()) + "-" + spec.name + "-" + PointName(point.index);
@@ -665,7 +657,7 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
         if (camera.value("name", "") != p->camera) continue;
         const Eigen::Vector3d& at = point.at[k].position;
         const Eigen::Vector3d look_at =
-            AimedLookAt(at, p->look_at, PlacedUp(*p, camera), point.at[k].pan, point.at[k].tilt);
+            AimedLookAt(at, p->look_at, PlacedUp(*p, unmoved_inputs.rig), point.at[k].pan, point.at[k].tilt);
         camera["position"] = {at.x(), at.y(), at.z()};
         camera["look_at"] = {look_at.x(), look_at.y(), look_at.z()};
         if (p->has_up) camera["up"] = {p->up.x(), p->up.y(), p->up.z()};

@@ -124,6 +124,7 @@ Rig LoadRig(const std::filesystem::path& path) {
     }
     rig.cameras.push_back(cam);
     rig.timing.push_back(timing);
+    rig.up.push_back(up);
     rig.sensor_overrides.push_back(c.Has("sensor") ? c["sensor"].raw() : nlohmann::json());
   }
   return rig;

@@ -18,6 +18,9 @@ struct Rig {
   std::string scene;  // the scene the rig was designed for (default for --scene)
   std::vector<Camera> cameras;
   std::vector<CameraTiming> timing;  // per camera: fps, exposure
+  // Per camera, the rig file's "up" (default +z): the world direction its
+  // view was levelled by (cam_from_world keeps only the image's up).
+  std::vector<Eigen::Vector3d> up;
   // Per camera, the "sensor" object of the rig file (knob overrides of the
   // sensor preset: {"sensor": {...}, "flicker": {...}}), or null.
   std::vector<nlohmann::json> sensor_overrides;

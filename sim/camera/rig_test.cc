@@ -118,6 +118,21 @@ TEST_F(RigErrorTest, NamesTheField) {
             "(no error)");
 }
 
+// The rig keeps each camera's "up" as written (+z when left out), and its
+// image's up is that up with the view direction taken out.
+TEST_F(RigErrorTest, EachCamerasUpIsKept) {
+  const std::string intrinsics = R"("fx": 300, "fy": 300, "cx": 160, "cy": 120, )" + dist_ + ", " + pose_;
+  const Rig rig = LoadRig(Write(R"({"format": "irbench.rig/1", "cameras": [{"name": "a", )" + intrinsics +
+                                R"(}, {"name": "b", "up": [1, 0, 1], )" + intrinsics + "}]}"));
+  ASSERT_EQ(rig.up.size(), 2u);
+  EXPECT_EQ(rig.up[0], Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(rig.up[1], Eigen::Vector3d(1, 0, 1));
+  // Camera b looks along -y: its image's up (-y_cam in the world) is the
+  // written up's direction, the view's component being zero already.
+  const Eigen::Vector3d image_up = -(rig.cameras[1].cam_from_world.linear().transpose() * Eigen::Vector3d::UnitY());
+  EXPECT_NEAR((image_up - Eigen::Vector3d(1, 0, 1).normalized()).norm(), 0, 1e-9);
+}
+
 // Issue 27.3: camera names "..", ".", 300 characters or non-ASCII reached the
 // file system and OpenCV (exit 1 with a raw message); only [A-Za-z0-9_-],
 // 1-64 characters, not starting with '-', are accepted.
