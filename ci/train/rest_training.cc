@@ -87,6 +87,11 @@ RestTrainingResult RunRestTraining(const RestTrainingOptions& options) {
   int sampled = 0;
   const ArmSamples train =
       SampleArms(options.avatars, options.motions, "--avatars", "--motions", options, scene, &progress, &sampled);
+  // Held out sampled before anything is written: a bad held-out motion
+  // leaves no model behind.
+  const ArmSamples test = test_runs > 0 ? SampleArms(options.test_avatars, options.test_motions, "--test-avatars",
+                                                     "--test-motions", options, scene, &progress, &sampled)
+                                        : ArmSamples{};
   const std::vector<std::array<float, 6>>& features = train.features;
   const std::vector<int>& labels = train.labels;
   RestTrainingResult result;
@@ -100,18 +105,14 @@ RestTrainingResult RunRestTraining(const RestTrainingOptions& options) {
   }
   result.model = options.out.empty() ? DefaultRestModelPath() : options.out;
   if (result.model.has_parent_path()) std::filesystem::create_directories(result.model.parent_path());
-  classifier.Save(result.model);
-  if (test_runs > 0) {
-    const ArmSamples test = SampleArms(options.test_avatars, options.test_motions, "--test-avatars", "--test-motions",
-                                       options, scene, &progress, &sampled);
-    result.test_samples = static_cast<int>(test.features.size());
-    int agree = 0;
-    for (size_t i = 0; i < test.features.size(); ++i) {
-      result.test_at_rest += test.labels[i];
-      agree += classifier.AtRest(test.features[i]) == (test.labels[i] == 1);
-    }
-    if (result.test_samples > 0) result.test_accuracy = double(agree) / result.test_samples;
+  result.test_samples = static_cast<int>(test.features.size());
+  int agree = 0;
+  for (size_t i = 0; i < test.features.size(); ++i) {
+    result.test_at_rest += test.labels[i];
+    agree += classifier.AtRest(test.features[i]) == (test.labels[i] == 1);
   }
+  if (result.test_samples > 0) result.test_accuracy = double(agree) / result.test_samples;
+  classifier.Save(result.model);
   return result;
 }
 

@@ -65,6 +65,12 @@ TEST(RestTraining, AHeldOutMotionOrAvatarAlsoTrainedOnIsRefused) {
     EXPECT_NE(std::string(e.what()).find("--test-avatars"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("p2"), std::string::npos) << e.what();
   }
+  // A held-out motion that does not load leaves no model behind.
+  RestTrainingOptions missing = SmallTraining(dir / "x.yml");
+  missing.test_avatars = {"p6"};
+  missing.test_motions = {(dir / "no_such.bvh").string()};
+  EXPECT_THROW(RunRestTraining(missing), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.yml"));
   EXPECT_FALSE(std::filesystem::exists(dir / "m.yml"));
   EXPECT_FALSE(std::filesystem::exists(dir / "a.yml"));
 }
