@@ -679,22 +679,46 @@ TEST(PoseTracker, TheHeightIsMeasuredStandingUpStraight) {
   BodyCalibration partial(options);
   model = partial.Start(shape.height_m);
   for (double top : {1.77, 1.79, 1.79}) {
+    EXPECT_TRUE(partial.takes_height_sample(false));
     EXPECT_TRUE(partial.MeasureHeightAndGirth(true, upright, top, true, false, score, &model));
   }
   EXPECT_NEAR(model.height_m, 1.79, 1e-9);
   EXPECT_TRUE(partial.measuring_height());
+  EXPECT_TRUE(partial.takes_height_sample(true));
   EXPECT_TRUE(partial.MeasureHeightAndGirth(true, upright, 1.74, true, true, score, &model));
   EXPECT_NEAR(model.height_m, 1.74, 1e-9);
   EXPECT_TRUE(partial.MeasureHeightAndGirth(true, upright, 1.76, true, true, score, &model));
   EXPECT_NEAR(model.height_m, 1.76, 1e-9);  // the upper median
   // Once all views measured, a view left out measures nothing.
+  EXPECT_FALSE(partial.takes_height_sample(false));
   EXPECT_FALSE(partial.MeasureHeightAndGirth(true, upright, 1.70, true, false, score, &model));
   EXPECT_NEAR(model.height_m, 1.76, 1e-9);
   for (int f = 2; f < options.height_frames; ++f) {
     EXPECT_TRUE(partial.measuring_height());
+    EXPECT_TRUE(partial.takes_height_sample(true));
     partial.MeasureHeightAndGirth(true, upright, 1.75, true, true, score, &model);
   }
   EXPECT_FALSE(partial.measuring_height());
+  for (bool all_views : {true, false}) {
+    EXPECT_FALSE(partial.takes_height_sample(all_views));
+    EXPECT_FALSE(partial.MeasureHeightAndGirth(true, upright, 1.75, true, all_views, score, &model));
+  }
+
+  // A camera dead all take: its frames fill height_frames, then measure
+  // nothing more (the feet need no looking at) while the height is still
+  // provisional, until all views are back.
+  BodyCalibration dead(options);
+  model = dead.Start(shape.height_m);
+  for (int f = 0; f < options.height_frames; ++f) {
+    EXPECT_TRUE(dead.takes_height_sample(false));
+    EXPECT_TRUE(dead.MeasureHeightAndGirth(true, upright, 1.78, true, false, score, &model));
+  }
+  EXPECT_TRUE(dead.measuring_height());
+  EXPECT_FALSE(dead.takes_height_sample(false));
+  EXPECT_FALSE(dead.MeasureHeightAndGirth(true, upright, 1.78, true, false, score, &model));
+  EXPECT_TRUE(dead.takes_height_sample(true));
+  EXPECT_TRUE(dead.MeasureHeightAndGirth(true, upright, 1.74, true, true, score, &model));
+  EXPECT_NEAR(model.height_m, 1.74, 1e-9);
 
   for (auto set : {+[](PoseTrackerOptions* o) { o->height_max_lean_deg = 0; },
                    +[](PoseTrackerOptions* o) { o->height_min_waist = 1.5; }}) {

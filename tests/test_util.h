@@ -25,7 +25,9 @@ inline std::string ReadText(const std::filesystem::path& path);
 
 #ifdef IRBENCH_BINARY_DIR
 // Runs the built irbench with `args` (each quoted) in the shell, its stdout
-// and stderr captured through files in `dir`.
+// and stderr captured through files in `dir`. A run killed by a signal (the
+// shell's exit code 128 + the signal) prints its command and stderr here: the
+// caller's assertion on the exit code alone would not say why.
 inline Result RunIrbench(const std::vector<std::string>& args, const std::filesystem::path& dir) {
   std::string command = std::string(IRBENCH_BINARY_DIR) + "/irbench";
   for (const std::string& a : args) command += " '" + a + "'";
@@ -35,6 +37,10 @@ inline Result RunIrbench(const std::vector<std::string>& args, const std::filesy
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = ReadText(dir / "stdout.txt");
   r.err = ReadText(dir / "stderr.txt");
+  if (r.exit_code > 128) {
+    std::fprintf(stderr, "RunIrbench: exit %d (signal %d) from %s\nits stderr:\n%s\n", r.exit_code,
+                 r.exit_code - 128, command.c_str(), r.err.c_str());
+  }
   return r;
 }
 #endif

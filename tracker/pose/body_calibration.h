@@ -54,6 +54,16 @@ class BodyCalibration {
   bool measuring_height() const {
     return static_cast<int>(heights_.size()) < options_.height_frames || partial_views_;
   }
+  // Would MeasureHeightAndGirth take this frame's measurement, were its
+  // other conditions met, with `all_views` or a camera left out? False with
+  // a camera left out once a frame was measured with all views, and once
+  // height_frames are in (unless they were taken with cameras left out and
+  // all views are back): the frame's feet then need no looking at.
+  bool takes_height_sample(bool all_views) const {
+    if (all_views && partial_views_) return true;
+    if (!all_views && !heights_.empty() && !partial_views_) return false;
+    return static_cast<int>(heights_.size()) < options_.height_frames;
+  }
 
   // Until the height is measured, a model more than 10 % off the hull's top
   // `top_m` (metres, clamped to 1.2-2.2) takes the top's height: updates

@@ -352,13 +352,14 @@ void PoseTracker::Calibrate(const FrameFeatures& features, const std::vector<Sil
     return Evaluate(shape, pose, views, nullptr);
   };
   // Without a voxel hull (the front end's placement alone) the feet are
-  // taken to be on the floor.
-  const bool feet_on_floor = !out->tracking || !calibration_.measuring_height() || !features.voxels ||
+  // taken to be on the floor; they are looked for only in a frame that
+  // could be measured (with a camera dead all take, not every frame).
+  const bool all_views = features.UsableCameras() == static_cast<int>(features.cameras.size());
+  const bool feet_on_floor = !out->tracking || !calibration_.takes_height_sample(all_views) || !features.voxels ||
                              FeetOnFloor(*features.voxels, PoseBody(shape_, out->pose).joints[kModelRoot],
                                          shape_.height_m, options_.hull_legs);
   if (const std::optional<double> ratio = calibration_.MeasureHeightAndGirth(
-          out->tracking, out->pose, features.placement->top_m, feet_on_floor,
-          features.UsableCameras() == static_cast<int>(features.cameras.size()), score, &shape_)) {
+          out->tracking, out->pose, features.placement->top_m, feet_on_floor, all_views, score, &shape_)) {
     for (BodyPose& p : *proposed) p.dof[kDofZ] *= *ratio;
     for (BodyPose& p : particles_) p.dof[kDofZ] *= *ratio;
     out->pose.dof[kDofZ] *= *ratio;
