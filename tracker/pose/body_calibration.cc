@@ -56,6 +56,7 @@ std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking,
                                                              bool all_views,
                                                              const ShapeScore& score,
                                                              BodyShape* shape) {
+  if (!takes_height_sample(all_views)) return std::nullopt;
   const PosedBody body = PoseBody(*shape, estimate);
   const bool arms_low =
       body.joints[kModelRightHandTip].z() < body.joints[kModelRightShoulder].z() &&
@@ -79,35 +80,31 @@ std::optional<double> BodyCalibration::MeasureHeightAndGirth(bool tracking,
     girths_.clear();
     partial_views_ = false;
   }
-  if (!all_views && !heights_.empty() && !partial_views_) return std::nullopt;
   if (!all_views) partial_views_ = true;
-  if (static_cast<int>(heights_.size()) < options_.height_frames) {
-    // Searched with the torso and head upright: a twisted torso is how a
-    // too-narrow model covers a wide body. The girth reaches 2.4: capped
-    // at 1.5, the heavy p3 (who takes 1.65-2.0) kept a torso too narrow,
-    // and the filter spread the arms to cover it (full suite, seeds 1-3:
-    // p3's rest 93 -> 98 %, waist 5.6 -> 4.0 cm).
-    const double top_height = std::clamp(top_m, 1.2, 2.2);
-    double best_ll = -std::numeric_limits<double>::infinity(), best_girth = 1.0;
-    BodyPose upright = estimate;
-    for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith})
-      upright.dof[d] = 0;
-    upright.dof[kDofZ] *= top_height / shape->height_m;
-    for (double girth : {0.9, 1.05, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.2, 2.4}) {
-      const double ll = score(ShapeFor(top_height, girth), upright);
-      if (ll > best_ll) {
-        best_ll = ll;
-        best_girth = girth;
-      }
+  // Searched with the torso and head upright: a twisted torso is how a
+  // too-narrow model covers a wide body. The girth reaches 2.4: capped
+  // at 1.5, the heavy p3 (who takes 1.65-2.0) kept a torso too narrow,
+  // and the filter spread the arms to cover it (full suite, seeds 1-3:
+  // p3's rest 93 -> 98 %, waist 5.6 -> 4.0 cm).
+  const double top_height = std::clamp(top_m, 1.2, 2.2);
+  double best_ll = -std::numeric_limits<double>::infinity(), best_girth = 1.0;
+  BodyPose straight = estimate;
+  for (int d : {kDofWaistZ, kDofWaistX, kDofWaistY, kDofNeckAzimuth, kDofNeckZenith})
+    straight.dof[d] = 0;
+  straight.dof[kDofZ] *= top_height / shape->height_m;
+  for (double girth : {0.9, 1.05, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.2, 2.4}) {
+    const double ll = score(ShapeFor(top_height, girth), straight);
+    if (ll > best_ll) {
+      best_ll = ll;
+      best_girth = girth;
     }
-    heights_.push_back(top_height);
-    girths_.push_back(best_girth);
-    const double height = std::clamp(Median(heights_), 1.2, 2.2);
-    const double ratio = height / shape->height_m;
-    *shape = ShapeFor(height, Median(girths_));
-    return ratio;
   }
-  return std::nullopt;
+  heights_.push_back(top_height);
+  girths_.push_back(best_girth);
+  const double height = std::clamp(Median(heights_), 1.2, 2.2);
+  const double ratio = height / shape->height_m;
+  *shape = ShapeFor(height, Median(girths_));
+  return ratio;
 }
 
 // Arm thickness: p5's jacket sleeves measure a third thicker than bare
