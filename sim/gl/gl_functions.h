@@ -79,7 +79,8 @@ namespace irbench {
   X(PFNGLSTENCILMASKPROC, StencilMask)                                 \
   X(PFNGLDEPTHMASKPROC, DepthMask)                                     \
   X(PFNGLCLEARBUFFERFIPROC, ClearBufferfi)                             \
-  X(PFNGLDRAWARRAYSPROC, DrawArrays)
+  X(PFNGLDRAWARRAYSPROC, DrawArrays)                                   \
+  X(PFNGLSCISSORPROC, Scissor)
 
 struct GlFunctions {
 #define IRBENCH_GL_MEMBER(type, name) type name = nullptr;

@@ -667,23 +667,30 @@ void Renderer::Draw(int index) {
     DrawStatic(person_flag);
     return;
   }
-  // The static scene's images and depth, then the person over them.
+  // The static scene's images and depth where the last frame drew over them
+  // (the rest still holds them), then the person over them.
   const Camera& rc = t.render_camera;
   gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.cache_fbo);
   gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, t.fbo);
-  for (int i = 0; i < 3; ++i) {
-    GLenum one_buffer[] = {GL_NONE, GL_NONE, GL_NONE};
-    one_buffer[i] = buffers[i];
-    gl.ReadBuffer(buffers[i]);
-    gl.DrawBuffers(3, one_buffer);
-    gl.BlitFramebuffer(0, 0, rc.width, rc.height, 0, 0, rc.width, rc.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  for (const Eigen::Vector4i& box : t.restore) {
+    const Eigen::Vector4i r = box.cwiseMax(0).cwiseMin(Eigen::Vector4i(rc.width, rc.height, rc.width, rc.height));
+    if (r[0] >= r[2] || r[1] >= r[3]) continue;
+    for (int i = 0; i < 3; ++i) {
+      GLenum one_buffer[] = {GL_NONE, GL_NONE, GL_NONE};
+      one_buffer[i] = buffers[i];
+      gl.ReadBuffer(buffers[i]);
+      gl.DrawBuffers(3, one_buffer);
+      gl.BlitFramebuffer(r[0], r[1], r[2], r[3], r[0], r[1], r[2], r[3], GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    gl.BlitFramebuffer(r[0], r[1], r[2], r[3], r[0], r[1], r[2], r[3], GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT,
+                       GL_NEAREST);
   }
-  gl.BlitFramebuffer(0, 0, rc.width, rc.height, 0, 0, rc.width, rc.height,
-                     GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT, GL_NEAREST);
+  t.restore.clear();
   gl.DrawBuffers(3, buffers);
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   BeginCameraPass(t);
   if (!person_visible_ || person_index_count_ == 0) return;
+  t.restore.push_back(PersonPixels(t));
   // As when the person is drawn first and the scene after it, both with a
   // LESS test: the person's nearest depth wins ties with the scene (a depth
   // pass, LEQUAL, stencil 2 where the person is), then the first of its
@@ -713,6 +720,32 @@ void Renderer::Draw(int index) {
   gl.DepthFunc(GL_LESS);
   if (!shadow_maps_.empty()) ShadeShadowedPixels(t);
   gl.Disable(GL_STENCIL_TEST);
+}
+
+Eigen::Vector4i Renderer::PersonPixels(const Target& t) const {
+  const Camera& rc = t.render_camera;
+  const Eigen::Vector4i all(0, 0, rc.width, rc.height);
+  if (person_positions_.size() != person_vertex_count_ || person_positions_.empty()) return all;
+  // A triangle's pixels lie inside its vertices' extent unless the near plane
+  // clips it (clip w is the camera-frame z).
+  float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+  const float near = static_cast<float>(options_.near_m) * 1.01f;
+  for (const Eigen::Vector3f& p : person_positions_) {
+    const Eigen::Vector4f clip = t.clip_from_world * p.homogeneous();
+    if (!(clip.w() > near)) return all;
+    const float x = clip.x() / clip.w(), y = clip.y() / clip.w();
+    x0 = std::min(x0, x);
+    y0 = std::min(y0, y);
+    x1 = std::max(x1, x);
+    y1 = std::max(y1, y);
+  }
+  // Window pixels, two wider for rounding (and clamped: a far-off extent
+  // must not overflow).
+  const auto pixel = [](float ndc, int size) {
+    return static_cast<int>(std::floor(std::clamp((ndc * 0.5f + 0.5f) * size, -4.0f, size + 4.0f)));
+  };
+  return Eigen::Vector4i(pixel(x0, rc.width) - 2, pixel(y0, rc.height) - 2, pixel(x1, rc.width) + 3,
+                         pixel(y1, rc.height) + 3);
 }
 
 void Renderer::ReadBack(int index) {

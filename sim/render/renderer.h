@@ -119,9 +119,12 @@ class Renderer {
   struct ShadowMap;
   void UpdateShadows();
   void UpdatePersonExtents();
+  // The render pixels camera `t`'s draw of the person can touch (x0, y0, x1,
+  // y1, ends excluded); all of them when a vertex lies near or behind it.
+  Eigen::Vector4i PersonPixels(const Target& t) const;
   void UpdateStaticCache();
   void BeginCameraPass(const Target& t);
-  void ShadeShadowedPixels(const Target& t);
+  void ShadeShadowedPixels(Target& t);
   void TileStaticCache(Target& t);
   void DrawPerson(int person_flag_location);
   void DrawStatic(int person_flag_location);

@@ -34,6 +34,10 @@ struct Renderer::Target {
   // blocker depths.
   unsigned cache_fbo = 0, cache_depth_rbo = 0;
   unsigned cache_tex[5] = {0, 0, 0, 0, 0};
+  // Render pixels (x0, y0, x1, y1, ends excluded) where fbo may differ from
+  // the cache: the person's extent and the re-shaded tiles of the last
+  // frame; all of it after the cache is drawn. Only these are copied back.
+  std::vector<Eigen::Vector4i> restore{Eigen::Vector4i(0, 0, 1 << 30, 1 << 30)};
   // Per tile of kStaticCacheTile pixels a side (row-major), for
   // ShadeShadowedPixels: per shadow slot the uv extent of its static surfaces
   // (min u, min v, max u, max v; empty when min > max), how far their taps

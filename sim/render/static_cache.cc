@@ -94,6 +94,7 @@ void Renderer::UpdateStaticCache() {
     DrawStatic(gl.GetUniformLocation(program_, "u_person"));
     if (!shadow_maps_.empty()) TileStaticCache(*target);
     size_scratch(*target, false);
+    target->restore.assign(1, Eigen::Vector4i(0, 0, target->render_camera.width, target->render_camera.height));
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while drawing the static scene's cache");
@@ -132,7 +133,7 @@ void Renderer::TileStaticCache(Target& t) {
   }
 }
 
-void Renderer::ShadeShadowedPixels(const Target& t) {
+void Renderer::ShadeShadowedPixels(Target& t) {
   // Stencil 0 -> 1 on the static pixels (not the person's) of every tile
   // whose shadow taps may come within two texels of the person's extent in a
   // shadow map (the mark pass writes no colour), then the static scene drawn
@@ -142,6 +143,7 @@ void Renderer::ShadeShadowedPixels(const Target& t) {
   const Camera& rc = t.render_camera;
   const float texel = 1.0f / options_.shadow_map_size;
   std::vector<float> quads;
+  Eigen::Vector4i marked(rc.width, rc.height, 0, 0);  // their pixels' extent
   for (int ty = 0; ty < t.tiles_y; ++ty) {
     for (int tx = 0; tx < t.tiles_x; ++tx) {
       const size_t tile = size_t(ty) * t.tiles_x + tx;
@@ -155,6 +157,9 @@ void Renderer::ShadeShadowedPixels(const Target& t) {
                Meets(t.tile_uv[tile][k], margin, person_boxes_[k]);
       }
       if (!near) continue;
+      marked = Eigen::Vector4i(std::min(marked[0], tx * kStaticCacheTile), std::min(marked[1], ty * kStaticCacheTile),
+                               std::max(marked[2], std::min((tx + 1) * kStaticCacheTile, rc.width)),
+                               std::max(marked[3], std::min((ty + 1) * kStaticCacheTile, rc.height)));
       // The tile's pixels in normalised device coordinates.
       const auto ndc = [](int pixel, int size) { return 2.0f * std::min(pixel, size) / size - 1; };
       const float x0 = ndc(tx * kStaticCacheTile, rc.width), x1 = ndc((tx + 1) * kStaticCacheTile, rc.width);
@@ -163,6 +168,11 @@ void Renderer::ShadeShadowedPixels(const Target& t) {
     }
   }
   if (quads.empty()) return;
+  t.restore.push_back(marked);
+  // Nothing outside the marked tiles is drawn: llvmpipe then skips the rest of
+  // the frame's bins instead of testing the static scene's fragments there.
+  gl.Enable(GL_SCISSOR_TEST);
+  gl.Scissor(marked[0], marked[1], marked[2] - marked[0], marked[3] - marked[1]);
   gl.StencilFunc(GL_EQUAL, 0, 0xFF);
   gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR);
   gl.Disable(GL_DEPTH_TEST);
@@ -185,6 +195,7 @@ void Renderer::ShadeShadowedPixels(const Target& t) {
   DrawStatic(gl.GetUniformLocation(program_, "u_person"));
   gl.DepthMask(GL_TRUE);
   gl.DepthFunc(GL_LESS);
+  gl.Disable(GL_SCISSOR_TEST);
 }
 
 }  // namespace irbench
