@@ -395,13 +395,16 @@ void Renderer::SetLighting(const std::vector<IrLight>& lights, double ambient) {
     gl.DeleteRenderbuffers(1, &m->static_depth_rbo);
   }
   shadow_maps_.clear();
-  if (options_.shadows && shadow_array_ == 0) {
-    // Four layers of camera-frame z, one per shadowing light, and the same
-    // for the static scene alone.
+  const int layers = static_cast<int>(std::clamp<long>(
+      std::count_if(lights.begin(), lights.begin() + n, [](const IrLight& l) { return l.casts_shadows; }), 1, 4));
+  if (options_.shadows && layers != shadow_layers_) {
+    // A layer of camera-frame z per shadowing light (up to four; one when
+    // none), and the same for the static scene alone.
+    shadow_layers_ = layers;
     for (unsigned* array : {&shadow_array_, &static_shadow_array_}) {
-      gl.GenTextures(1, array);
+      if (*array == 0) gl.GenTextures(1, array);
       gl.BindTexture(GL_TEXTURE_2D_ARRAY, *array);
-      gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, options_.shadow_map_size, options_.shadow_map_size, 4,
+      gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, options_.shadow_map_size, options_.shadow_map_size, layers,
                     0, GL_RED, GL_FLOAT, nullptr);
       gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
       gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -772,10 +775,10 @@ void Renderer::Resample(int index, CameraImages* out, bool want_depth) {
   // good lens's blur) so edges fall between supersamples instead of snapping
   // to them; this keeps sub-pixel corner positions unbiased and steady.
   // Half floats (11-bit mantissa: far below the shot noise) halve the
-  // read-back; the blur works in float.
+  // read-back; the blur works in float, in place (one image fewer per camera).
   t.raw_half.convertTo(t.raw_radiance, CV_32F);
-  cv::GaussianBlur(t.raw_radiance, t.blurred_radiance, cv::Size(0, 0), 0.5 * options_.supersample);
-  cv::remap(t.blurred_radiance, out->radiance, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(t.raw_radiance, t.raw_radiance, cv::Size(0, 0), 0.5 * options_.supersample);
+  cv::remap(t.raw_radiance, out->radiance, t.map_x, t.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   // The plain grey image: every channel at level 1, 1 = 255.
   cv::transform(out->radiance, out->grey, cv::Matx14f(255.0f, 255.0f, 255.0f, 255.0f));
   out->grey.convertTo(out->grey, CV_8U);

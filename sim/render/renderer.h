@@ -144,6 +144,7 @@ class Renderer {
   unsigned shadow_program_ = 0;
   std::vector<std::unique_ptr<ShadowMap>> shadow_maps_;
   unsigned shadow_array_ = 0;  // GL_TEXTURE_2D_ARRAY, a layer per shadow map
+  int shadow_layers_ = 0;      // its layers (and the static array's)
   // The static scene's layers, drawn once per scene and lighting; each frame
   // starts from a copy of them and draws the person only.
   unsigned static_shadow_array_ = 0;

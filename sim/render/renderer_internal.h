@@ -47,7 +47,7 @@ struct Renderer::Target {
   std::vector<float> tile_reach;
   std::vector<Eigen::Vector4f> tile_blocker_depth;
   cv::Mat map_x, map_y;  // output pixel -> render pixel
-  cv::Mat raw_half, raw_radiance, raw_mask, raw_depth, blurred_radiance, blurred_mask;
+  cv::Mat raw_half, raw_radiance, raw_mask, raw_depth, blurred_mask;
   Eigen::Matrix4f clip_from_world;
 };
 
