@@ -542,8 +542,8 @@ void Renderer::UpdateShadows() {
   // keep the scene).
   for (size_t k = 0; k < shadow_maps_.size(); ++k) {
     ShadowMap& map = *shadow_maps_[k];
-    const Eigen::Vector4i r = map.dirty.cwiseMax(0).cwiseMin(size);
-    if (r[0] < r[2] && r[1] < r[3]) {
+    const Eigen::Vector4i r = Clamp(map.dirty, size, size);
+    if (!Empty(r)) {
       gl.BindFramebuffer(GL_READ_FRAMEBUFFER, map.static_fbo);
       gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, map.fbo);
       gl.BlitFramebuffer(r[0], r[1], r[2], r[3], r[0], r[1], r[2], r[3], GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT,
@@ -554,12 +554,7 @@ void Renderer::UpdateShadows() {
     DrawPerson(-1);
     // The texels drawn: those whose centres the person's projection covers,
     // inside its extent (two texels wider for rounding).
-    const Eigen::Vector4f& box = person_boxes_[k];
-    map.dirty = box[0] > box[2] ? Eigen::Vector4i(0, 0, 0, 0)
-                                : Eigen::Vector4i(int(std::floor(std::max(box[0], -1.0f) * size)) - 2,
-                                                  int(std::floor(std::max(box[1], -1.0f) * size)) - 2,
-                                                  int(std::ceil(std::min(box[2], 2.0f) * size)) + 2,
-                                                  int(std::ceil(std::min(box[3], 2.0f) * size)) + 2);
+    map.dirty = PixelsOf(person_boxes_[k], size, size);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   shadows_dirty_ = false;
@@ -675,9 +670,7 @@ void Renderer::Draw(int index) {
   const Camera& rc = t.render_camera;
   gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.cache_fbo);
   gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, t.fbo);
-  for (const Eigen::Vector4i& box : t.restore) {
-    const Eigen::Vector4i r = box.cwiseMax(0).cwiseMin(Eigen::Vector4i(rc.width, rc.height, rc.width, rc.height));
-    if (r[0] >= r[2] || r[1] >= r[3]) continue;
+  if (const Eigen::Vector4i r = Clamp(t.restore, rc.width, rc.height); !Empty(r)) {
     for (int i = 0; i < 3; ++i) {
       GLenum one_buffer[] = {GL_NONE, GL_NONE, GL_NONE};
       one_buffer[i] = buffers[i];
@@ -688,12 +681,12 @@ void Renderer::Draw(int index) {
     gl.BlitFramebuffer(r[0], r[1], r[2], r[3], r[0], r[1], r[2], r[3], GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT,
                        GL_NEAREST);
   }
-  t.restore.clear();
+  t.restore = kNoPixels;
   gl.DrawBuffers(3, buffers);
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   BeginCameraPass(t);
   if (!person_visible_ || person_index_count_ == 0) return;
-  t.restore.push_back(PersonPixels(t));
+  t.restore = PersonPixels(t);
   // As when the person is drawn first and the scene after it, both with a
   // LESS test: the person's nearest depth wins ties with the scene (a depth
   // pass, LEQUAL, stencil 2 where the person is), then the first of its
@@ -742,13 +735,8 @@ Eigen::Vector4i Renderer::PersonPixels(const Target& t) const {
     x1 = std::max(x1, x);
     y1 = std::max(y1, y);
   }
-  // Window pixels, two wider for rounding (and clamped: a far-off extent
-  // must not overflow).
-  const auto pixel = [](float ndc, int size) {
-    return static_cast<int>(std::floor(std::clamp((ndc * 0.5f + 0.5f) * size, -4.0f, size + 4.0f)));
-  };
-  return Eigen::Vector4i(pixel(x0, rc.width) - 2, pixel(y0, rc.height) - 2, pixel(x1, rc.width) + 3,
-                         pixel(y1, rc.height) + 3);
+  // Normalised device coordinates to window uv.
+  return PixelsOf(Eigen::Vector4f(x0, y0, x1, y1) * 0.5f + Eigen::Vector4f::Constant(0.5f), rc.width, rc.height);
 }
 
 void Renderer::ReadBack(int index) {

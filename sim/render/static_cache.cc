@@ -94,7 +94,7 @@ void Renderer::UpdateStaticCache() {
     DrawStatic(gl.GetUniformLocation(program_, "u_person"));
     if (!shadow_maps_.empty()) TileStaticCache(*target);
     size_scratch(*target, false);
-    target->restore.assign(1, Eigen::Vector4i(0, 0, target->render_camera.width, target->render_camera.height));
+    target->restore = Eigen::Vector4i(0, 0, target->render_camera.width, target->render_camera.height);
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeError("OpenGL error while drawing the static scene's cache");
@@ -143,7 +143,7 @@ void Renderer::ShadeShadowedPixels(Target& t) {
   const Camera& rc = t.render_camera;
   const float texel = 1.0f / options_.shadow_map_size;
   std::vector<float> quads;
-  Eigen::Vector4i marked(rc.width, rc.height, 0, 0);  // their pixels' extent
+  Eigen::Vector4i marked = kNoPixels;  // their pixels' extent
   for (int ty = 0; ty < t.tiles_y; ++ty) {
     for (int tx = 0; tx < t.tiles_x; ++tx) {
       const size_t tile = size_t(ty) * t.tiles_x + tx;
@@ -157,9 +157,9 @@ void Renderer::ShadeShadowedPixels(Target& t) {
                Meets(t.tile_uv[tile][k], margin, person_boxes_[k]);
       }
       if (!near) continue;
-      marked = Eigen::Vector4i(std::min(marked[0], tx * kStaticCacheTile), std::min(marked[1], ty * kStaticCacheTile),
-                               std::max(marked[2], std::min((tx + 1) * kStaticCacheTile, rc.width)),
-                               std::max(marked[3], std::min((ty + 1) * kStaticCacheTile, rc.height)));
+      marked = Union(marked, Eigen::Vector4i(tx * kStaticCacheTile, ty * kStaticCacheTile,
+                                             std::min((tx + 1) * kStaticCacheTile, rc.width),
+                                             std::min((ty + 1) * kStaticCacheTile, rc.height)));
       // The tile's pixels in normalised device coordinates.
       const auto ndc = [](int pixel, int size) { return 2.0f * std::min(pixel, size) / size - 1; };
       const float x0 = ndc(tx * kStaticCacheTile, rc.width), x1 = ndc((tx + 1) * kStaticCacheTile, rc.width);
@@ -168,7 +168,7 @@ void Renderer::ShadeShadowedPixels(Target& t) {
     }
   }
   if (quads.empty()) return;
-  t.restore.push_back(marked);
+  t.restore = Union(t.restore, marked);
   // Nothing outside the marked tiles is drawn: llvmpipe then skips the rest of
   // the frame's bins instead of testing the static scene's fragments there.
   gl.Enable(GL_SCISSOR_TEST);
