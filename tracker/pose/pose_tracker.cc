@@ -398,16 +398,21 @@ bool PoseTracker::RestVote(const std::vector<std::optional<PosedBody>>& voters, 
 BodyPose PoseTracker::HangingArmPose(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
                                      double* ll) const {
   // Forced down: the hanging pose the silhouettes like best, out to the
-  // side or a little forward, the forearm straight or bent forward.
+  // side, a little forward or back, the forearm straight or bent forward.
   // People seldom hang their arms dead straight; against a single
   // straight pose a bent hanging arm lost enough overlap to fail the
-  // likelihood-ratio test.
+  // likelihood-ratio test. Real motion swings and holds its hanging arms
+  // further than the library's: a walking arm back or forward, a wave's
+  // other arm 20 degrees out (CMU 141_16, 05_01: arms 12.4 -> 6.8 and
+  // 7.7 -> 4.5 cm with these candidates; docs/tracker.md).
   const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
   const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
   BodyPose down = pose;
   double down_ll = -std::numeric_limits<double>::infinity();
-  for (const auto& [shoulder_azimuth, shoulder_zenith] : {std::pair{0.0, 0.1}, std::pair{M_PI / 2, 0.15}}) {
-    for (const double elbow_zenith : {0.0, 0.4, 0.8}) {
+  static constexpr std::pair<double, double> kShoulders[] = {  // azimuth, zenith
+      {0.0, 0.1}, {M_PI / 2, 0.15}, {M_PI / 2, 0.35}, {-M_PI / 2, 0.25}, {0.0, 0.35}};
+  for (const auto& [shoulder_azimuth, shoulder_zenith] : kShoulders) {
+    for (const double elbow_zenith : {0.0, 0.4, 0.8, 1.1}) {
       BodyPose candidate = pose;
       candidate.dof[sh] = shoulder_azimuth;
       candidate.dof[sh + 1] = shoulder_zenith;
