@@ -44,8 +44,8 @@ int RunTrainRest(const CLI::App& cmd, TrainRestArgs& args) {
 // What `irbench train atoms`' flags bind to.
 struct TrainAtomsArgs {
   AtomTrainingOptions job;
-  std::vector<std::string> sequences;
-  std::string out, weights = "non_negative", rule = "centroids";
+  std::vector<std::string> sequences, candidates;
+  std::string out, weights = "non_negative", rule = "centroids", selection_table;
 };
 
 // Learns the atoms; prints the training and held-out accuracies and the model file.
@@ -53,10 +53,21 @@ int RunTrainAtoms(const CLI::App& cmd, TrainAtomsArgs& args) {
   RequireNotEmpty(cmd, "--out", args.out);
   AtomTrainingOptions& job = args.job;
   for (const std::string& s : args.sequences) job.sequences.emplace_back(s);
+  for (const std::string& s : args.candidates) job.candidates.emplace_back(s);
+  if (cmd.count("--selection-table")) RequireNotEmpty(cmd, "--selection-table", args.selection_table);
+  job.selection_table = args.selection_table;
   job.out = args.out;
   job.weights = args.weights == "matching_pursuit" ? AtomWeights::kMatchingPursuit : AtomWeights::kNonNegative;
   job.rule = args.rule == "thresholds" ? PairRule::kThresholds : PairRule::kCentroids;
   const AtomTrainingResult r = RunAtomTraining(job);
+  if (r.selection) {
+    std::cout << "atoms selected among " << r.selection->candidates.size() << " candidate postures:";
+    for (int i : r.selection->selected) {
+      const auto& c = r.selection->candidates[i];
+      std::cout << " " << c.name << " (A" << c.atom << ": " << c.about << ")";
+    }
+    std::cout << "\n";
+  }
   std::cout << "posture atoms: " << r.frames << " frames, pairs right on " << r.training_accuracy * 100
             << "% of the training frames\n";
   for (const auto& [name, acc] : r.held_out) std::cout << "  " << name << " held out: " << acc * 100 << "%\n";
@@ -206,6 +217,14 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   atoms_cmd->add_option("SEQ", atom_args->sequences, "rendered sequences with truth, one person each")
       ->required()
       ->check(CLI::ExistingDirectory);
+  atoms_cmd->add_option("--candidates", atom_args->candidates,
+                        "renders of the 30 candidate postures (irbench render --motion posture_candidates),\n"
+                        "one person each: the arm atoms are the candidates selected by the SVD of their\n"
+                        "matching-pursuit weights (thesis 5.1.2) instead of the truth's atoms' frames")
+      ->check(CLI::ExistingDirectory);
+  atoms_cmd->add_option("--selection-table", atom_args->selection_table,
+                        "with --candidates: write the selection, the singular values and the weight\n"
+                        "matrix (Figs. 5.1, 5.2) as Markdown to this file");
   atoms_cmd->add_option("--weights", atom_args->weights, "how atom weights are found")
       ->capture_default_str()
       ->check(CLI::IsMember({"non_negative", "matching_pursuit"}));

@@ -826,7 +826,9 @@ TEST(CliTest, OutOfRangeNumbersAndEmptyPathsAreRefused) {
            {{"suite", "run", "smoke", "--cache", ""}, "--cache"},
            {{"motion", "export", "--motion", "wave", "--seed", "-1", (dir / "m.bvh").string()}, "--seed"},
            {{"train", "rest", "--folds", "1", "--out", out}, "--folds"},
-           {{"train", "rest", "--out", ""}, "--out"}}) {
+           {{"train", "rest", "--out", ""}, "--out"},
+           {{"train", "atoms", dir.string(), "--selection-table", "", "--out", out}, "--selection-table"},
+           {{"train", "atoms", dir.string(), "--selection-table", out + ".md", "--out", out}, "--selection-table"}}) {
     const Result bad = RunIrbench(args, dir);
     EXPECT_EQ(bad.exit_code, 2) << args[0] << " " << option << ": " << bad.err;
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;

@@ -21,29 +21,7 @@ namespace {
 
 using irbench::testing::BodyMesh;
 using irbench::testing::DistanceToPolyline;
-
-// The posed body's voxels at `voxel_m`: centres inside the mesh.
-VoxelHull Voxelise(const BodyMesh& body, double voxel_m) {
-  VoxelHull hull;
-  hull.voxel_size_m = voxel_m;
-  hull.origin_m = body.lo - Eigen::Vector3d::Constant(2 * voxel_m);
-  const Eigen::Vector3d extent = body.hi - body.lo + Eigen::Vector3d::Constant(4 * voxel_m);
-  hull.nx = static_cast<int>(std::ceil(extent.x() / voxel_m));
-  hull.ny = static_cast<int>(std::ceil(extent.y() / voxel_m));
-  hull.nz = static_cast<int>(std::ceil(extent.z() / voxel_m));
-  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
-  for (int z = 0; z < hull.nz; ++z) {
-    for (int y = 0; y < hull.ny; ++y) {
-      for (int x = 0; x < hull.nx; ++x) {
-        if (irbench::testing::Inside(body, hull.VoxelCenter(x, y, z))) {
-          hull.occupied[hull.Index(x, y, z)] = 1;
-          ++hull.occupied_count;
-        }
-      }
-    }
-  }
-  return hull;
-}
+using irbench::testing::Voxelise;
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

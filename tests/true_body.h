@@ -12,6 +12,7 @@
 
 #include "sim/body/avatar.h"
 #include "sim/sequence/render_job.h"
+#include "tracker/hull/voxel_hull.h"
 
 namespace irbench::testing {
 
@@ -96,6 +97,29 @@ inline BodyMesh PosedBody(const RenderInputs& in, int frame) {
   }
   body.Bucket();
   return body;
+}
+
+// The posed body's voxels at `voxel_m`: centres inside the mesh.
+inline VoxelHull Voxelise(const BodyMesh& body, double voxel_m) {
+  VoxelHull hull;
+  hull.voxel_size_m = voxel_m;
+  hull.origin_m = body.lo - Eigen::Vector3d::Constant(2 * voxel_m);
+  const Eigen::Vector3d extent = body.hi - body.lo + Eigen::Vector3d::Constant(4 * voxel_m);
+  hull.nx = static_cast<int>(std::ceil(extent.x() / voxel_m));
+  hull.ny = static_cast<int>(std::ceil(extent.y() / voxel_m));
+  hull.nz = static_cast<int>(std::ceil(extent.z() / voxel_m));
+  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  for (int z = 0; z < hull.nz; ++z) {
+    for (int y = 0; y < hull.ny; ++y) {
+      for (int x = 0; x < hull.nx; ++x) {
+        if (Inside(body, hull.VoxelCenter(x, y, z))) {
+          hull.occupied[hull.Index(x, y, z)] = 1;
+          ++hull.occupied_count;
+        }
+      }
+    }
+  }
+  return hull;
 }
 
 }  // namespace irbench::testing

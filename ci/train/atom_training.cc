@@ -2,11 +2,17 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <Eigen/QR>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
+#include <spdlog/fmt/fmt.h>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/json_reader.h"
 #include "common/logging.h"
 #include "common/paths.h"
 #include "common/progress.h"
@@ -14,6 +20,8 @@
 #include "sequence_format/manifest.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/frame_tracker.h"
+#include "sim/motion/library.h"
+#include "tracker/posture/atom_selection.h"
 #include "tracker/posture/decompose.h"
 
 namespace irbench {
@@ -43,6 +51,7 @@ struct TrainingSequence {
   nlohmann::json about;  // for the provenance
   std::vector<SparseDescriptor> frames;
   std::vector<std::array<int, 2>> pairs;  // the truth's, atom indices in order
+  std::vector<int> frame_index;           // each frame's number in the sequence
   std::vector<float> own_rest;            // the person's resting posture, unit length
 };
 
@@ -99,6 +108,7 @@ TrainingSequence ReadSequence(const fs::path& dir, const ShapeDescriptorOptions&
     }
     s.frames.push_back(std::move(d));
     s.pairs.push_back({std::min(a, b), std::max(a, b)});
+    s.frame_index.push_back(f);
   }
   if (rest_frames == 0) throw InputError(dir.string(), "truth", "the person is never at rest with both arms");
   double norm = 0;
@@ -249,10 +259,211 @@ double AccuracyOn(const PostureAtoms& atoms, const std::vector<const TrainingSeq
   return Accuracy(atoms, seqs, weights);
 }
 
+// One person's candidate postures: each `posture_candidate` event's hold,
+// less a tenth of a second at either end (the arm still settling), as the
+// mean rest residual of its frames, and the truth's pairs over them.
+struct PersonCandidates {
+  std::map<std::string, std::vector<double>> residual_sum;
+  std::map<std::string, int> frames;
+  std::map<std::string, std::map<std::array<int, 2>, int>> pairs;
+};
+
+PersonCandidates ReadCandidates(const fs::path& dir, const TrainingSequence& s, int bins, double fps) {
+  const fs::path events_file = dir / "truth" / "events.json";
+  const JsonNode events = ParseJsonFile(events_file.string());
+  std::map<int, size_t> by_frame;
+  for (size_t i = 0; i < s.frame_index.size(); ++i) by_frame[s.frame_index[i]] = i;
+  const int trim = static_cast<int>(std::lround(0.1 * fps));
+  PersonCandidates p;
+  for (size_t e = 0; e < events.Size(); ++e) {
+    if (events[e].GetString("kind") != "posture_candidate") continue;
+    const std::string name = events[e].GetString("value");
+    const int first = events[e].GetInt("start_frame"), last = events[e].GetInt("end_frame");
+    if (last < first) events[e]["end_frame"].Fail("ends before it starts");
+    std::vector<double>& sum = p.residual_sum[name];
+    sum.resize(bins, 0.0);
+    int& count = p.frames[name];
+    for (int f = first + trim; f <= last - trim; ++f) {
+      const auto it = by_frame.find(f);
+      if (it == by_frame.end()) continue;
+      double alpha0 = 0;
+      const std::vector<float> r = RestResidual(s.frames[it->second].Dense(bins), s.own_rest, &alpha0);
+      for (int i = 0; i < bins; ++i) sum[i] += r[i];
+      ++count;
+      ++p.pairs[name][s.pairs[it->second]];
+    }
+  }
+  if (p.residual_sum.empty()) {
+    throw InputError(events_file.string(), "", "no posture_candidate events: not a rendering of "
+                                               "irbench render --motion posture_candidates");
+  }
+  for (auto& [name, sum] : p.residual_sum) {
+    if (p.frames[name] == 0) throw InputError(events_file.string(), name, "no tracked frame in its hold");
+    for (double& v : sum) v /= p.frames[name];
+  }
+  return p;
+}
+
+// How well `vectors` stand for the candidates (unit columns of `c`): the
+// share of c's Frobenius norm outside their span, and the largest cosine
+// between two of them (the thesis wants atoms that do not compete).
+void SpanAndOverlap(const Eigen::MatrixXd& c, const std::vector<std::vector<float>>& vectors, double* residual,
+                    double* overlap) {
+  Eigen::MatrixXd a(c.rows(), static_cast<int>(vectors.size()));
+  for (size_t k = 0; k < vectors.size(); ++k) {
+    for (int i = 0; i < c.rows(); ++i) a(i, static_cast<int>(k)) = vectors[k][i];
+    a.col(static_cast<int>(k)).normalize();
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(a);
+  const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(a.rows(), a.cols());
+  *residual = (c - q * (q.transpose() * c)).norm() / c.norm();
+  *overlap = 0;
+  for (int i = 0; i < a.cols(); ++i) {
+    for (int j = i + 1; j < a.cols(); ++j) *overlap = std::max(*overlap, a.col(i).dot(a.col(j)));
+  }
+}
+
+// The selection among the candidate renders' postures (5.1.2), each
+// candidate named by the truth's atom for its posture, and compared with
+// `atoms` (trained from the truth's atoms); `about` gets it for the model
+// file's provenance.
+AtomSelectionSummary SelectFromCandidates(const AtomTrainingOptions& options, const ShapeDescriptorOptions& shape,
+                                          const PostureAtoms& atoms, nlohmann::json* about) {
+  const int bins = shape.bin_count();
+  std::vector<PersonCandidates> persons;
+  nlohmann::json sequences = nlohmann::json::array();
+  for (const fs::path& dir : options.candidates) {
+    if (!HasManifest(dir)) throw InputError(dir.string(), "manifest.json", "not a rendered sequence");
+    const TrainingSequence seq = ReadSequence(dir, shape);
+    persons.push_back(ReadCandidates(dir, seq, bins, SequenceInput::Open(dir).fps()));
+    sequences.push_back(seq.about);
+  }
+  AtomSelectionSummary summary;
+  std::vector<std::vector<float>> parts;
+  const std::vector<std::string> descriptions = PostureCandidateDescriptions();
+  for (const auto& [name, unused] : persons.front().residual_sum) {
+    std::vector<double> mean(bins, 0.0);
+    std::map<std::array<int, 2>, int> pairs;
+    for (size_t q = 0; q < persons.size(); ++q) {
+      const auto it = persons[q].residual_sum.find(name);
+      if (it == persons[q].residual_sum.end() || persons[q].residual_sum.size() != persons.front().residual_sum.size()) {
+        throw InputError(options.candidates[q].string(), "truth/events.json",
+                         "holds other candidates than " + options.candidates.front().string());
+      }
+      for (int i = 0; i < bins; ++i) mean[i] += it->second[i] / persons.size();
+      for (const auto& [pair, n] : persons[q].pairs[name]) pairs[pair] += n;
+    }
+    const auto most = std::max_element(pairs.begin(), pairs.end(),
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    AtomSelectionSummary::Candidate c;
+    c.name = name;
+    const int number = std::atoi(name.c_str() + 1);
+    c.about = number >= 1 && number <= static_cast<int>(descriptions.size()) ? descriptions[number - 1] : "";
+    c.atom = most->first[1];
+    parts.emplace_back(mean.begin(), mean.end());
+    summary.candidates.push_back(c);
+  }
+  const int count = atoms.atom_count() - 1;
+  if (static_cast<int>(parts.size()) < count) {
+    throw InputError(options.candidates.front().string(), "truth/events.json",
+                     "fewer candidates than the " + std::to_string(count) + " arm atoms");
+  }
+  const AtomSelection sel = SelectAtoms(parts, count, atoms.overlap_threshold);
+  summary.weights = sel.weights;
+  summary.singular_values = sel.singular_values;
+  summary.selected = sel.selected;
+  // Against the truth's atoms: how much of the candidates each set spans.
+  Eigen::MatrixXd c(bins, static_cast<int>(parts.size()));
+  for (size_t j = 0; j < parts.size(); ++j) {
+    for (int i = 0; i < bins; ++i) c(i, static_cast<int>(j)) = parts[j][i];
+    c.col(static_cast<int>(j)).normalize();
+  }
+  std::vector<std::vector<float>> chosen;
+  for (int i : sel.selected) chosen.push_back(parts[i]);
+  SpanAndOverlap(c, chosen, &summary.selected_residual, &summary.selected_overlap);
+  SpanAndOverlap(c, atoms.arms, &summary.atoms_residual, &summary.atoms_overlap);
+  const Eigen::VectorXd sc = Eigen::BDCSVD<Eigen::MatrixXd>(c).singularValues();
+  summary.best_residual = std::sqrt(sc.tail(sc.size() - count).squaredNorm() / sc.squaredNorm());
+  const Eigen::VectorXd& sv = sel.singular_values;
+  std::set<int> named;
+  for (int i : sel.selected) named.insert(summary.candidates[i].atom);
+  summary.one_per_atom = static_cast<int>(named.size()) == count && !named.count(0);
+
+  nlohmann::json selected = nlohmann::json::array();
+  for (int i : sel.selected) {
+    selected.push_back({{"candidate", summary.candidates[i].name}, {"about", summary.candidates[i].about},
+                        {"truth_atom", AtomNames()[summary.candidates[i].atom]}});
+  }
+  std::vector<double> singular;
+  for (int i = 0; i < sv.size(); ++i) singular.push_back(std::round(sv(i) * 1e4) / 1e4);
+  const auto r4 = [](double v) { return std::round(v * 1e4) / 1e4; };
+  *about = {{"method", "thesis 5.1.2: each candidate's mean rest residual, the matrix of their pairwise "
+                       "matching-pursuit weights, its SVD, the candidates pivoted first by a column-pivoted QR "
+                       "of the leading right singular vectors; reported beside the atoms, which stay the truth's"},
+            {"candidate_sequences", sequences},
+            {"candidates", summary.candidates.size()},
+            {"singular_values", singular},
+            {"selected", selected},
+            {"one_per_truth_atom", summary.one_per_atom},
+            {"unspanned_share", {{"selected", r4(summary.selected_residual)}, {"atoms", r4(summary.atoms_residual)}}},
+            {"largest_cosine", {{"selected", r4(summary.selected_overlap)}, {"atoms", r4(summary.atoms_overlap)}}}};
+  return summary;
+}
+
+void CheckSelectionTable(const AtomTrainingOptions& options) {
+  if (options.selection_table.empty()) return;
+  if (options.candidates.empty()) {
+    throw InputError("", "--selection-table", "there is a selection only with --candidates");
+  }
+  std::vector<fs::path> inputs = options.sequences;
+  inputs.insert(inputs.end(), options.candidates.begin(), options.candidates.end());
+  CheckOutputApart(options.selection_table, inputs, "--selection-table");
+}
+
 }  // namespace
+
+std::string AtomSelectionSummary::Markdown() const {
+  std::string md = "# Posture atoms selected among " + std::to_string(candidates.size()) +
+                   " candidates (thesis 5.1.2)\n\n"
+                   "M(i, j): the weight of candidate j when candidate i is decomposed by matching pursuit with j "
+                   "as its only atom (each candidate its mean rest residual, at unit length). The atoms are the "
+                   "first pivots of a column-pivoted QR of M's leading right singular vectors.\n\n"
+                   "## Selected\n\n| order | candidate | posture | truth's atom |\n|---|---|---|---|\n";
+  for (size_t o = 0; o < selected.size(); ++o) {
+    const Candidate& c = candidates[selected[o]];
+    md += fmt::format("| {} | {} | {} | {} |\n", o + 1, c.name, c.about, AtomNames()[c.atom]);
+  }
+  md += fmt::format(
+      "\nOne candidate per truth atom (A1..A4): {}. The trained atoms stay the truth's (its posture labels name "
+      "them).\n\n| | share of the candidates outside their span | largest cosine between two |\n|---|---|---|\n"
+      "| the selected candidates | {:.3f} | {:.3f} |\n| the truth's atoms, as trained | {:.3f} | {:.3f} |\n"
+      "| the best rank-{} approximation (SVD) | {:.3f} | |\n",
+      one_per_atom ? "yes" : "no", selected_residual, selected_overlap, atoms_residual, atoms_overlap,
+      selected.size(), best_residual);
+  md += "\n## Singular values of M (Fig. 5.2)\n\n| k | singular value | share of the sum of squares |\n|---|---|---|\n";
+  const double total = singular_values.squaredNorm();
+  for (int k = 0; k < singular_values.size(); ++k) {
+    md += fmt::format("| {} | {:.4f} | {:.1f}% |\n", k + 1, singular_values(k),
+                      total > 0 ? 100 * singular_values(k) * singular_values(k) / total : 0.0);
+  }
+  md += "\n## Candidates\n\n| candidate | posture | truth's atom |\n|---|---|---|\n";
+  for (const Candidate& c : candidates) md += fmt::format("| {} | {} | {} |\n", c.name, c.about, AtomNames()[c.atom]);
+  md += "\n## M (Fig. 5.1)\n\n|   |";
+  for (const Candidate& c : candidates) md += " " + c.name + " |";
+  md += "\n|---|";
+  for (size_t j = 0; j < candidates.size(); ++j) md += "---|";
+  md += "\n";
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    md += "| " + candidates[i].name + " |";
+    for (size_t j = 0; j < candidates.size(); ++j) md += fmt::format(" {:.2f} |", weights(int(i), int(j)));
+    md += "\n";
+  }
+  return md;
+}
 
 AtomTrainingResult RunAtomTraining(const AtomTrainingOptions& options) {
   if (options.sequences.empty()) throw InputError("", "SEQ", "give at least one rendered sequence");
+  CheckSelectionTable(options);
   const ShapeDescriptorOptions shape;
   std::vector<TrainingSequence> seqs;
   for (const fs::path& dir : options.sequences) {
@@ -289,8 +500,16 @@ AtomTrainingResult RunAtomTraining(const AtomTrainingOptions& options) {
                       {"rest", "each person's own: the mean descriptor over the truth's both-arms-at-rest frames"},
                       {"training_accuracy", std::round(result.training_accuracy * 1e4) / 1e4},
                       {"held_out_accuracy", held_out}};
+  if (!options.candidates.empty()) {
+    nlohmann::json about;
+    result.selection = SelectFromCandidates(options, shape, atoms, &about);
+    atoms.provenance["selection"] = about;
+  }
   result.model = options.out.empty() ? DefaultPostureAtomsPath() : options.out;
   atoms.Save(result.model);
+  if (result.selection && !options.selection_table.empty()) {
+    AtomicWriteFile(options.selection_table, result.selection->Markdown());
+  }
   return result;
 }
 

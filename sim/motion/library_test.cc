@@ -179,6 +179,43 @@ TEST(LibraryTest, EveryMotionBuildsAndKeepsFeetOnTheFloor) {
   EXPECT_NEAR((ctx.state.position - Eigen::Vector2d(1.0, 0.5)).norm(), 0, 1e-12);
 }
 
+// The 30 candidate postures (thesis 5.1.2): one event per hold, each hold a
+// still pose of the candidate arm alone, all 30 different, and the atoms'
+// own postures among them where docs/motion.md says (the truth's rule names
+// them: C03 A1, C19 A2, C05 A3, C01 A4).
+TEST(LibraryTest, PostureCandidatesHoldThirtyDistinctOneArmPostures) {
+  for (const char* side : {"right", "left"}) {
+    const Avatar avatar = Person("p3");
+    MotionContext ctx{&avatar, &Theater(), StyleFor("p3", 2), {}};
+    const MotionPtr m = BuildLibraryMotion("posture_candidates", {{"side", side}}, ctx);
+    const Labeler labeler(avatar, &Theater(), *m);
+    const int arm = std::string(side) == "right" ? kRightShoulder : kLeftShoulder;
+    std::vector<Eigen::Vector3d> wrists;
+    int holds = 0;
+    for (const MotionEvent& e : m->Events()) {
+      if (e.kind != "posture_candidate") continue;
+      ++holds;
+      EXPECT_EQ(e.value, (holds < 10 ? "C0" : "C") + std::to_string(holds));
+      EXPECT_EQ(e.side, side);
+      const JointTransforms a = ForwardKinematics(avatar.skeleton, m->At(e.start + 0.05));
+      const JointTransforms b = ForwardKinematics(avatar.skeleton, m->At(e.end - 0.05));
+      const Eigen::Vector3d wrist = b[arm + 2].translation() - b[arm].translation();
+      // Held: the wrist moves only by the tremor.
+      EXPECT_LT((a[arm + 2].translation() - b[arm + 2].translation()).norm(), 0.02) << e.value;
+      for (const Eigen::Vector3d& w : wrists) EXPECT_GT((w - wrist).norm(), 0.05) << e.value;
+      wrists.push_back(wrist);
+      const nlohmann::json labels = labeler.Labels(0.5 * (e.start + e.end));
+      EXPECT_EQ(labels["rest"][std::string(side) == "right" ? "left" : "right"], true) << e.value;
+      const std::map<std::string, std::string> atoms = {{"C03", "A1"}, {"C19", "A2"}, {"C05", "A3"}, {"C01", "A4"}};
+      if (atoms.count(e.value)) {
+        EXPECT_EQ(labels["posture"], nlohmann::json({atoms.at(e.value), "A0"})) << e.value;
+      }
+    }
+    EXPECT_EQ(holds, 30);
+    EXPECT_EQ(PostureCandidateDescriptions().size(), 30u);
+  }
+}
+
 TEST(LibraryTest, StyleOverridesAreCheckedAndApplied) {
   const MotionStyle st = StyleFor("p1", 1, {{"tempo", 1.5}, {"handedness", "left"}}, "avatars/x.json");
   EXPECT_EQ(st.tempo, 1.5);
