@@ -19,7 +19,7 @@
 #include <Eigen/QR>
 
 #include "sim/motion/labels.h"
-#include "sim/motion/library.h"
+#include "sim/motion/posture_candidates.h"
 #include "sim/sequence/render_job.h"
 #include "tests/true_body.h"
 #include "tracker/posture/atom_selection.h"

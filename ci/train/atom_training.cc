@@ -20,7 +20,7 @@
 #include "sequence_format/manifest.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/frame_tracker.h"
-#include "sim/motion/library.h"
+#include "sim/motion/posture_candidates.h"
 #include "tracker/posture/atom_selection.h"
 #include "tracker/posture/decompose.h"
 

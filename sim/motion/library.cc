@@ -7,6 +7,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "sim/motion/keyframes.h"
+#include "sim/motion/posture_candidates.h"
 
 namespace irbench {
 namespace {
@@ -504,63 +505,15 @@ MotionPtr AtomTour(const nlohmann::json& params, Builder& b) {
   return b.Standing("atom_tour", keys, {});
 }
 
-// The thesis's 30 candidate postures for selecting the atoms (5.1.2): one
-// arm (`side`, default the dominant) held in each in turn, the other at
-// rest. Straight arms over a grid of directions (azimuth 0 out to the side,
-// 45 diagonally forward, 90 forward, -30 behind the shoulder line;
-// elevation -45 to 70), the overhead atom, and eight bent arms. The atoms
-// A1, A3 and A4 (docs/motion.md) are among the grid, A2 is candidate 19.
-// Each hold is a `posture_candidate` event whose value names the candidate
-// (C01..C30); PostureCandidates() describes them.
-struct CandidateArm {
-  const char* about;
-  double az, el, elbow;
-  Eigen::Vector3d bend;
-};
-
-const std::vector<CandidateArm>& CandidateArms() {
-  const Eigen::Vector3d none = Eigen::Vector3d::Zero(), up(0, 0, 1), fwd(0, 1, 0), in(-1, 0, 0);
-  static const std::vector<CandidateArm> arms = {
-      {"straight, out to the side, 45 deg down", 0, -45, 0, none},
-      {"straight, out to the side, 20 deg down", 0, -20, 0, none},
-      {"straight, out to the side, horizontal", 0, 0, 0, none},
-      {"straight, out to the side, 20 deg up", 0, 20, 0, none},
-      {"straight, out to the side, 45 deg up", 0, 45, 0, none},
-      {"straight, out to the side, 70 deg up", 0, 70, 0, none},
-      {"straight, diagonally forward, 45 deg down", 45, -45, 0, none},
-      {"straight, diagonally forward, 20 deg down", 45, -20, 0, none},
-      {"straight, diagonally forward, horizontal", 45, 0, 0, none},
-      {"straight, diagonally forward, 20 deg up", 45, 20, 0, none},
-      {"straight, diagonally forward, 45 deg up", 45, 45, 0, none},
-      {"straight, diagonally forward, 70 deg up", 45, 70, 0, none},
-      {"straight, forward, 45 deg down", 90, -45, 0, none},
-      {"straight, forward, 20 deg down", 90, -20, 0, none},
-      {"straight, forward, horizontal", 90, 0, 0, none},
-      {"straight, forward, 20 deg up", 90, 20, 0, none},
-      {"straight, forward, 45 deg up", 90, 45, 0, none},
-      {"straight, forward, 70 deg up", 90, 70, 0, none},
-      {"overhead (the A2 atom)", 10, 80, 5, none},
-      {"straight, behind the shoulder line, 45 deg up", -30, 45, 0, none},
-      {"straight, behind the shoulder line, horizontal", -30, 0, 0, none},
-      {"straight, behind the shoulder line, 45 deg down", -30, -45, 0, none},
-      {"upper arm out horizontal, forearm up", 0, 0, 90, up},
-      {"upper arm out horizontal, forearm forward", 0, 0, 90, fwd},
-      {"upper arm forward horizontal, forearm up", 90, 0, 90, up},
-      {"upper arm forward horizontal, forearm across", 90, 0, 80, in},
-      {"upper arm hanging, forearm forward", 0, -75, 90, fwd},
-      {"upper arm 45 deg down diagonally forward, forearm across the belly", 45, -45, 100, in},
-      {"upper arm out 45 deg up, forearm over the head", 0, 45, 110, in},
-      {"straight, across the chest", 120, 0, 0, none},
-  };
-  return arms;
-}
-
+// The thesis's 30 candidate postures for selecting the atoms (5.1.2), one
+// arm in each in turn (posture_candidates.h); each hold a
+// `posture_candidate` event.
 MotionPtr PostureCandidateTour(const nlohmann::json& params, Builder& b) {
   const int d = SideParam(params, b);
   const double hold = Param(params, "hold_s", 0.8, b, 0.1, 60.0);
   std::vector<ArmKey> keys = {{0.0, b.Rest(1), b.Rest(-1)}};
   std::vector<MotionEvent> events;
-  const auto& arms = CandidateArms();
+  const auto& arms = PostureCandidateArms();
   for (size_t c = 0; c < arms.size(); ++c) {
     const CandidateArm& a = arms[c];
     ArmKey k{keys.back().t + b.T(0.7), b.Rest(1), b.Rest(-1)};
@@ -777,12 +730,6 @@ const std::vector<std::string>& GestureNames() {
   static const std::vector<std::string> names = {"point_horizontal", "flap_both", "direct_traffic",
                                                  "raise_overhead",   "flap_one",  "point_diagonal_both"};
   return names;
-}
-
-std::vector<std::string> PostureCandidateDescriptions() {
-  std::vector<std::string> out;
-  for (const CandidateArm& a : CandidateArms()) out.push_back(a.about);
-  return out;
 }
 
 std::vector<std::pair<std::string, std::string>> LibraryMotions() {

@@ -62,8 +62,4 @@ std::vector<std::pair<std::string, std::string>> LibraryMotions();
 // The six gestures of the thesis (5.3), ids 1..6 in order.
 const std::vector<std::string>& GestureNames();
 
-// The `posture_candidates` motion's 30 one-arm postures (thesis 5.1.2), in
-// order: candidate Cnn is element nn - 1, a description of the arm.
-std::vector<std::string> PostureCandidateDescriptions();
-
 }  // namespace irbench

@@ -10,6 +10,7 @@
 #include "common/error.h"
 #include "sim/motion/labels.h"
 #include "sim/motion/motion_test_util.h"
+#include "sim/motion/posture_candidates.h"
 #include "sim/motion/session.h"
 
 namespace irbench {
