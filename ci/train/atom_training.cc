@@ -18,9 +18,9 @@
 #include "common/progress.h"
 #include "sequence_format/frame_lines.h"
 #include "sequence_format/manifest.h"
+#include "sim/motion/posture_candidates.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/frame_tracker.h"
-#include "sim/motion/posture_candidates.h"
 #include "tracker/posture/atom_selection.h"
 #include "tracker/posture/decompose.h"
 
@@ -52,6 +52,7 @@ struct TrainingSequence {
   std::vector<SparseDescriptor> frames;
   std::vector<std::array<int, 2>> pairs;  // the truth's, atom indices in order
   std::vector<int> frame_index;           // each frame's number in the sequence
+  double fps = 0;
   std::vector<float> own_rest;            // the person's resting posture, unit length
 };
 
@@ -75,6 +76,7 @@ TrainingSequence ReadSequence(const fs::path& dir, const ShapeDescriptorOptions&
   const fs::path truth_file = dir / "truth" / "frames.jsonl";
   const std::map<int, nlohmann::json> truth = ReadFrameLines(truth_file);
   const SequenceInput input = SequenceInput::Open(dir);
+  s.fps = input.fps();
   TrackerSettings settings;
   FrameTracker tracker(input, settings, EffectiveFrontEndOptions(settings), LoadRestClassifier(settings));
   const int bins = shape.bin_count();
@@ -268,12 +270,12 @@ struct PersonCandidates {
   std::map<std::string, std::map<std::array<int, 2>, int>> pairs;
 };
 
-PersonCandidates ReadCandidates(const fs::path& dir, const TrainingSequence& s, int bins, double fps) {
+PersonCandidates ReadCandidates(const fs::path& dir, const TrainingSequence& s, int bins) {
   const fs::path events_file = dir / "truth" / "events.json";
   const JsonNode events = ParseJsonFile(events_file.string());
   std::map<int, size_t> by_frame;
   for (size_t i = 0; i < s.frame_index.size(); ++i) by_frame[s.frame_index[i]] = i;
-  const int trim = static_cast<int>(std::lround(0.1 * fps));
+  const int trim = static_cast<int>(std::lround(0.1 * s.fps));
   PersonCandidates p;
   for (size_t e = 0; e < events.Size(); ++e) {
     if (events[e].GetString("kind") != "posture_candidate") continue;
@@ -304,16 +306,21 @@ PersonCandidates ReadCandidates(const fs::path& dir, const TrainingSequence& s, 
   return p;
 }
 
+// `vectors` (of one size) as the columns of a matrix, each at unit length.
+Eigen::MatrixXd UnitColumns(const std::vector<std::vector<float>>& vectors) {
+  Eigen::MatrixXd a(static_cast<int>(vectors.front().size()), static_cast<int>(vectors.size()));
+  for (int k = 0; k < a.cols(); ++k) {
+    a.col(k) = Eigen::Map<const Eigen::VectorXf>(vectors[k].data(), a.rows()).cast<double>().normalized();
+  }
+  return a;
+}
+
 // How well `vectors` stand for the candidates (unit columns of `c`): the
 // share of c's Frobenius norm outside their span, and the largest cosine
 // between two of them (the thesis wants atoms that do not compete).
 void SpanAndOverlap(const Eigen::MatrixXd& c, const std::vector<std::vector<float>>& vectors, double* residual,
                     double* overlap) {
-  Eigen::MatrixXd a(c.rows(), static_cast<int>(vectors.size()));
-  for (size_t k = 0; k < vectors.size(); ++k) {
-    for (int i = 0; i < c.rows(); ++i) a(i, static_cast<int>(k)) = vectors[k][i];
-    a.col(static_cast<int>(k)).normalize();
-  }
+  const Eigen::MatrixXd a = UnitColumns(vectors);
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(a);
   const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(a.rows(), a.cols());
   *residual = (c - q * (q.transpose() * c)).norm() / c.norm();
@@ -335,7 +342,11 @@ AtomSelectionSummary SelectFromCandidates(const AtomTrainingOptions& options, co
   for (const fs::path& dir : options.candidates) {
     if (!HasManifest(dir)) throw InputError(dir.string(), "manifest.json", "not a rendered sequence");
     const TrainingSequence seq = ReadSequence(dir, shape);
-    persons.push_back(ReadCandidates(dir, seq, bins, SequenceInput::Open(dir).fps()));
+    persons.push_back(ReadCandidates(dir, seq, bins));
+    if (persons.back().residual_sum.size() != persons.front().residual_sum.size()) {
+      throw InputError(dir.string(), "truth/events.json",
+                       "holds other candidates than " + options.candidates.front().string());
+    }
     sequences.push_back(seq.about);
   }
   AtomSelectionSummary summary;
@@ -346,7 +357,7 @@ AtomSelectionSummary SelectFromCandidates(const AtomTrainingOptions& options, co
     std::map<std::array<int, 2>, int> pairs;
     for (size_t q = 0; q < persons.size(); ++q) {
       const auto it = persons[q].residual_sum.find(name);
-      if (it == persons[q].residual_sum.end() || persons[q].residual_sum.size() != persons.front().residual_sum.size()) {
+      if (it == persons[q].residual_sum.end()) {
         throw InputError(options.candidates[q].string(), "truth/events.json",
                          "holds other candidates than " + options.candidates.front().string());
       }
@@ -373,11 +384,7 @@ AtomSelectionSummary SelectFromCandidates(const AtomTrainingOptions& options, co
   summary.singular_values = sel.singular_values;
   summary.selected = sel.selected;
   // Against the truth's atoms: how much of the candidates each set spans.
-  Eigen::MatrixXd c(bins, static_cast<int>(parts.size()));
-  for (size_t j = 0; j < parts.size(); ++j) {
-    for (int i = 0; i < bins; ++i) c(i, static_cast<int>(j)) = parts[j][i];
-    c.col(static_cast<int>(j)).normalize();
-  }
+  const Eigen::MatrixXd c = UnitColumns(parts);
   std::vector<std::vector<float>> chosen;
   for (int i : sel.selected) chosen.push_back(parts[i]);
   SpanAndOverlap(c, chosen, &summary.selected_residual, &summary.selected_overlap);
