@@ -69,7 +69,7 @@ int RunTrainAtoms(const CLI::App& cmd, TrainAtomsArgs& args) {
     std::cout << "\n";
   }
   std::cout << "posture atoms: " << r.frames << " frames, pairs right on " << r.training_accuracy * 100
-            << "% of the training frames\n";
+            << "% of the training frames (by the weights alone)\n";
   for (const auto& [name, acc] : r.held_out) std::cout << "  " << name << " held out: " << acc * 100 << "%\n";
   std::cout << r.model.string() << "\n";
   return kExitOk;
@@ -231,6 +231,9 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   atoms_cmd->add_option("--rule", atom_args->rule, "how the pair follows from the weights")
       ->capture_default_str()
       ->check(CLI::IsMember({"centroids", "thresholds"}));
+  atoms_cmd->add_flag("!--no-rest-state", atom_args->job.pair_rest_state,
+                      "the tracker's pair from the atom weights alone; by default it agrees with the\n"
+                      "pose tracker's rest state (as many A0s as arms it finds at rest)");
   atoms_cmd->add_flag("!--no-cross-validation", atom_args->job.cross_validate,
                       "skip the leave-one-sequence-out accuracies");
   atoms_cmd->add_option("--out", atom_args->out, "model file (default: tracker/models/posture_atoms.json)");

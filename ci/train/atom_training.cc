@@ -156,6 +156,7 @@ PostureAtoms Fit(const std::vector<const TrainingSequence*>& train, const AtomTr
   atoms.names = AtomNames();
   atoms.weights = options.weights;
   atoms.rule = options.rule;
+  atoms.pair_rest_state = options.pair_rest_state;
   const int bins = shape.bin_count();
   // A0: the persons' resting postures, averaged.
   std::vector<double> rest(bins, 0.0);

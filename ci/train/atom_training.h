@@ -39,6 +39,10 @@ struct AtomTrainingOptions {
   std::filesystem::path out;                     // default: DefaultPostureAtomsPath()
   AtomWeights weights = AtomWeights::kNonNegative;
   PairRule rule = PairRule::kCentroids;
+  // The tracker's pair agrees with its rest state (PostureAtoms::pair_rest_state).
+  // The accuracies below are the descriptor's alone: the training sequences
+  // are not pose-tracked.
+  bool pair_rest_state = true;
   bool cross_validate = true;  // leave each sequence out once
 };
 
@@ -67,7 +71,7 @@ struct AtomTrainingResult {
   std::optional<AtomSelectionSummary> selection;  // with candidates
   std::filesystem::path model;
   int frames = 0;               // frames with a descriptor and a truth pair
-  double training_accuracy = 0;  // pairs right on the training frames
+  double training_accuracy = 0;  // pairs right on the training frames, by the weights alone
   // Per sequence left out: its name and the accuracy of the atoms learned
   // from the others (empty without cross_validate or with one sequence).
   std::vector<std::pair<std::string, double>> held_out;

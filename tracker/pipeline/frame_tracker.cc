@@ -350,7 +350,12 @@ FrameTracker::Step FrameTracker::Track(int f,
     const bool at_rest = step.pose && step.pose->tracking && step.pose->rest[0].value_or(false) &&
                          step.pose->rest[1].value_or(false);
     user_rest_.Update(step.shape->bins, at_rest);
-    step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_);
+    // How many arms the rest-state classifier finds at rest, when it judged both.
+    std::optional<int> arms_at_rest;
+    if (step.pose && step.pose->tracking && step.pose->rest[0] && step.pose->rest[1]) {
+      arms_at_rest = int{*step.pose->rest[0]} + int{*step.pose->rest[1]};
+    }
+    step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_, arms_at_rest);
   }
   if (gesture_recognizer_) {
     std::optional<GestureObservation> observation;

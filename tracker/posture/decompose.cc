@@ -103,29 +103,36 @@ std::vector<double> NonNegativeWeights(const std::vector<float>& residual, const
   return best;
 }
 
-std::array<int, 2> PairFromWeights(const std::vector<double>& arm_weights, const PostureAtoms& atoms) {
+std::array<int, 2> PairFromWeights(const std::vector<double>& arm_weights, const PostureAtoms& atoms,
+                                   std::optional<int> arms_at_rest) {
+  // How many A0s the pair must hold; -1: any.
+  const int rests = atoms.pair_rest_state && arms_at_rest ? std::clamp(*arms_at_rest, 0, 2) : -1;
   if (atoms.rule == PairRule::kCentroids) {
     double best = std::numeric_limits<double>::infinity();
     std::array<int, 2> pair{0, 0};
-    for (const auto& [name, centroid] : atoms.centroids) {
-      double d = 0;
-      const size_t n = centroid.size();
-      if (atoms.centroid_precision.size() == n * n) {
-        for (size_t i = 0; i < n; ++i) {
-          for (size_t j = 0; j < n; ++j) {
-            d += (arm_weights[i] - centroid[i]) * atoms.centroid_precision[i * n + j] * (arm_weights[j] - centroid[j]);
+    for (int pass = rests < 0 ? 1 : 0; pass < 2 && best == std::numeric_limits<double>::infinity(); ++pass) {
+      for (const auto& [name, centroid] : atoms.centroids) {
+        const size_t plus = name.find('+');
+        const int a = IndexOfName(atoms, name.substr(0, plus));
+        const int b = plus == std::string::npos ? 0 : IndexOfName(atoms, name.substr(plus + 1));
+        if (a < 0 || b < 0) continue;
+        // Pass 0 keeps to the pairs with the rest state's count of A0s.
+        if (pass == 0 && (a == 0) + (b == 0) != rests) continue;
+        double d = 0;
+        const size_t n = centroid.size();
+        if (atoms.centroid_precision.size() == n * n) {
+          for (size_t i = 0; i < n; ++i) {
+            for (size_t j = 0; j < n; ++j) {
+              d += (arm_weights[i] - centroid[i]) * atoms.centroid_precision[i * n + j] * (arm_weights[j] - centroid[j]);
+            }
           }
+        } else {
+          for (size_t k = 0; k < n; ++k) d += (arm_weights[k] - centroid[k]) * (arm_weights[k] - centroid[k]);
         }
-      } else {
-        for (size_t k = 0; k < n; ++k) d += (arm_weights[k] - centroid[k]) * (arm_weights[k] - centroid[k]);
+        if (d >= best) continue;
+        best = d;
+        pair = Ordered(a, b);
       }
-      if (d >= best) continue;
-      const size_t plus = name.find('+');
-      const int a = IndexOfName(atoms, name.substr(0, plus));
-      const int b = plus == std::string::npos ? 0 : IndexOfName(atoms, name.substr(plus + 1));
-      if (a < 0 || b < 0) continue;
-      best = d;
-      pair = Ordered(a, b);
     }
     return pair;
   }
@@ -134,10 +141,21 @@ std::array<int, 2> PairFromWeights(const std::vector<double>& arm_weights, const
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return arm_weights[a] > arm_weights[b]; });
   std::vector<int> present;
-  for (int k : order) {
-    if (arm_weights[k] < atoms.presence || present.size() >= 2) break;
-    present.push_back(k + 1);
-    if (arm_weights[k] >= atoms.instance && present.size() < 2) present.push_back(k + 1);
+  if (rests >= 0) {
+    // The 2 - rests heaviest, the first twice when it weighs two arms' worth
+    // or no other atom is present.
+    if (rests <= 1 && !order.empty()) present.push_back(order[0] + 1);
+    if (rests == 0 && !order.empty()) {
+      const bool twice = arm_weights[order[0]] >= atoms.instance || order.size() < 2 ||
+                         arm_weights[order[1]] < atoms.presence;
+      present.push_back(twice ? order[0] + 1 : order[1] + 1);
+    }
+  } else {
+    for (int k : order) {
+      if (arm_weights[k] < atoms.presence || present.size() >= 2) break;
+      present.push_back(k + 1);
+      if (arm_weights[k] >= atoms.instance && present.size() < 2) present.push_back(k + 1);
+    }
   }
   while (present.size() < 2) present.push_back(0);
   return Ordered(present[0], present[1]);
@@ -148,7 +166,7 @@ std::string PairName(const std::array<int, 2>& pair, const PostureAtoms& atoms) 
 }
 
 Posture DecomposePosture(const std::vector<float>& descriptor, const std::vector<float>& user_rest,
-                         const PostureAtoms& atoms) {
+                         const PostureAtoms& atoms, std::optional<int> arms_at_rest) {
   if (descriptor.size() != atoms.rest.size()) {
     throw std::invalid_argument("the descriptor has " + std::to_string(descriptor.size()) + " bins, the atoms " +
                                 std::to_string(atoms.rest.size()));
@@ -163,7 +181,7 @@ Posture DecomposePosture(const std::vector<float>& descriptor, const std::vector
           : NonNegativeWeights(residual, atoms.arms);
   p.weights.push_back(alpha0);
   p.weights.insert(p.weights.end(), arm_weights.begin(), arm_weights.end());
-  p.pair = alpha0 > 0 ? PairFromWeights(arm_weights, atoms) : std::array<int, 2>{0, 0};
+  p.pair = alpha0 > 0 ? PairFromWeights(arm_weights, atoms, arms_at_rest) : std::array<int, 2>{0, 0};
   return p;
 }
 

@@ -8,9 +8,11 @@
 //      with the most overlapping non-empty bins, Eq. 5.7; its weight
 //      <R, A_n> over <A_n, A_n>; the overlapping bins removed, Eq. 5.8), or
 //      non-negative least squares;
-//   3. the pair from the weights (posture_atoms.h, PairRule).
+//   3. the pair from the weights (posture_atoms.h, PairRule), agreeing with
+//      the pose tracker's rest state where the atoms ask for it.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,17 +46,25 @@ std::vector<double> MatchingPursuitWeights(const std::vector<float>& residual,
 // subset of atoms solved by its normal equations; up to 10 atoms).
 std::vector<double> NonNegativeWeights(const std::vector<float>& residual, const std::vector<std::vector<float>>& arms);
 
-// The pair from the arm atoms' weights by the atoms' rule.
-std::array<int, 2> PairFromWeights(const std::vector<double>& arm_weights, const PostureAtoms& atoms);
+// The pair from the arm atoms' weights by the atoms' rule. `arms_at_rest`:
+// how many arms (0-2) the pose tracker's rest-state classifier finds at rest,
+// when it has an answer; with atoms.pair_rest_state the rule then chooses
+// only among pairs with that many A0s (the centroids of such pairs; the
+// thresholds rule takes the 2 - n heaviest atoms, one twice when it weighs
+// `instance` or the next is under `presence`). Without an answer, or when no
+// centroid has that many A0s, the weights alone decide.
+std::array<int, 2> PairFromWeights(const std::vector<double>& arm_weights, const PostureAtoms& atoms,
+                                   std::optional<int> arms_at_rest = std::nullopt);
 
 // "A1+A3": a pair's name, its atoms' names in order.
 std::string PairName(const std::array<int, 2>& pair, const PostureAtoms& atoms);
 
 // Steps 1-3. `user_rest`: the user's resting posture at unit length, or
-// empty for the atoms' A0. Throws std::invalid_argument when the descriptor
-// does not have the atoms' bin count.
+// empty for the atoms' A0; `arms_at_rest` as PairFromWeights. Throws
+// std::invalid_argument when the descriptor does not have the atoms' bin
+// count.
 Posture DecomposePosture(const std::vector<float>& descriptor, const std::vector<float>& user_rest,
-                         const PostureAtoms& atoms);
+                         const PostureAtoms& atoms, std::optional<int> arms_at_rest = std::nullopt);
 
 // A user's resting posture: the running mean of their unit-length
 // descriptors on frames the tracker finds both arms at rest (the rest-state

@@ -85,7 +85,7 @@ void PostureAtoms::Check(const std::string& file) const {
 PostureAtoms PostureAtoms::Load(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
   root.CheckKeys({"format", "descriptor", "names", "rest", "arms", "weights", "iterations", "overlap_threshold", "rule",
-                  "presence", "instance", "centroids", "centroid_precision", "provenance"});
+                  "presence", "instance", "centroids", "centroid_precision", "pair_rest_state", "provenance"});
   if (root.GetString("format") != kFormat) {
     root["format"].Fail("must be " + std::string(kFormat) + " (got " + root.GetString("format") + ")");
   }
@@ -133,6 +133,7 @@ PostureAtoms PostureAtoms::Load(const std::filesystem::path& path) {
   const JsonNode centroids = root["centroids"];
   for (const std::string& pair : centroids.Keys()) a.centroids.emplace_back(pair, centroids[pair].Numbers());
   if (root.Has("centroid_precision")) a.centroid_precision = root["centroid_precision"].Numbers();
+  a.pair_rest_state = root.GetBool("pair_rest_state", false);
   a.provenance = root.Has("provenance") ? root["provenance"].raw() : nlohmann::json::object();
   a.Check(path.string());
   return a;
@@ -158,6 +159,7 @@ void PostureAtoms::Save(const std::filesystem::path& path) const {
   j["rule"] = PairRuleName(rule);
   j["presence"] = presence;
   j["instance"] = instance;
+  j["pair_rest_state"] = pair_rest_state;
   nlohmann::json c = nlohmann::json::object();
   for (const auto& [pair, w] : centroids) {
     nlohmann::json row = nlohmann::json::array();

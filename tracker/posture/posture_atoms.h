@@ -60,6 +60,13 @@ struct PostureAtoms {
   // inverse of the pairs' pooled within-pair covariance of the weights; K x K
   // row-major, K the arm atoms), Euclidean when empty.
   std::vector<double> centroid_precision;
+  // Whether the pair agrees with the pose tracker's rest state (thesis 6.4)
+  // where it has one: as many A0s in the pair as arms it finds at rest, the
+  // rule choosing only among those pairs (decompose.h). Two arms in one atom
+  // weigh 1.3-1.8 on the tracker's hulls, not 2, and an arm hanging
+  // diagonally down is close to rest in the descriptor; the rest state tells
+  // both apart. Files without the key predate it: false.
+  bool pair_rest_state = false;
   nlohmann::json provenance;  // how the file was made
 
   int atom_count() const { return static_cast<int>(names.size()); }

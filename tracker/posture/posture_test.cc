@@ -150,6 +150,47 @@ TEST(Posture, PairRules) {
   EXPECT_THROW(a.Check("x.json"), InputError);
 }
 
+// The pair agrees with the rest state's count of arms at rest: two arms in
+// one atom that weigh less than two (the tracker's hulls: 1.3-1.8), and an
+// arm whose weight is near rest's.
+TEST(Posture, PairAgreesWithTheRestState) {
+  PostureAtoms a = SyntheticAtoms();
+  a.rule = PairRule::kCentroids;
+  const std::vector<double> one_and_a_half = {1.4, 0.0, 0.0, 0.0};  // nearer A0+A1 ({1,0,0,0}) than A1+A1
+  const std::vector<double> faint = {0.3, 0.0, 0.0, 0.0};           // nearer rest
+  // Without pair_rest_state the count is ignored.
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a, 0), (std::array<int, 2>{0, 1}));
+  a.pair_rest_state = true;
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a), (std::array<int, 2>{0, 1}));
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a, 0), (std::array<int, 2>{1, 1}));
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a, 2), (std::array<int, 2>{0, 0}));
+  EXPECT_EQ(PairFromWeights(faint, a, 1), (std::array<int, 2>{0, 1}));
+  EXPECT_EQ(PairFromWeights(faint, a, std::nullopt), (std::array<int, 2>{0, 0}));
+  // Among the pairs with no A0, still the nearest: A1+A3 for one arm in each.
+  EXPECT_EQ(PairFromWeights({0.8, 0.1, 0.9, 0.0}, a, 0), (std::array<int, 2>{1, 3}));
+  // No centroid has the count: the weights alone decide.
+  a.centroids = {{"A0+A0", {0, 0, 0, 0}}, {"A0+A1", {1, 0, 0, 0}}};
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a, 0), (std::array<int, 2>{0, 1}));
+  // Thresholds: the 2 - n heaviest atoms, one twice when it weighs two
+  // arms' worth or nothing else is present.
+  a.rule = PairRule::kThresholds;
+  a.presence = 0.4;
+  a.instance = 1.5;
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a), (std::array<int, 2>{0, 1}));
+  EXPECT_EQ(PairFromWeights(one_and_a_half, a, 0), (std::array<int, 2>{1, 1}));
+  EXPECT_EQ(PairFromWeights({0.9, 0.0, 0.6, 0.0}, a, 0), (std::array<int, 2>{1, 3}));
+  EXPECT_EQ(PairFromWeights({0.9, 0.0, 0.6, 0.0}, a, 1), (std::array<int, 2>{0, 1}));
+  EXPECT_EQ(PairFromWeights({0.9, 0.0, 0.6, 0.0}, a, 2), (std::array<int, 2>{0, 0}));
+  EXPECT_EQ(PairFromWeights(faint, a, 1), (std::array<int, 2>{0, 1}));
+  // Through DecomposePosture: one arm in A3 with half its weight, the
+  // rest state finding one arm raised.
+  a.rule = PairRule::kCentroids;
+  a.centroids = {{"A0+A0", {0, 0, 0, 0}}, {"A0+A3", {0, 0, 1, 0}}, {"A3+A3", {0, 0, 2, 0}}};
+  const std::vector<float> f = Compose(a, 1.0, {0, 0, 0.3, 0});
+  EXPECT_EQ(DecomposePosture(f, {}, a).pair, (std::array<int, 2>{0, 0}));
+  EXPECT_EQ(DecomposePosture(f, {}, a, 1).pair, (std::array<int, 2>{0, 3}));
+}
+
 TEST(Posture, DecomposeUsesTheUsersRest) {
   PostureAtoms a = SyntheticAtoms();
   a.rule = PairRule::kThresholds;
@@ -192,6 +233,10 @@ TEST(Posture, ModelFileRoundTripAndErrors) {
   EXPECT_EQ(b.names, a.names);
   EXPECT_EQ(b.centroids, a.centroids);
   EXPECT_EQ(b.provenance, a.provenance);
+  EXPECT_FALSE(b.pair_rest_state);
+  a.pair_rest_state = true;
+  a.Save(dir / "atoms_rest.json");
+  EXPECT_TRUE(PostureAtoms::Load(dir / "atoms_rest.json").pair_rest_state);
   for (size_t i = 0; i < a.rest.size(); ++i) EXPECT_NEAR(b.rest[i], a.rest[i], 1e-6 * std::abs(a.rest[i]) + 1e-12);
   EXPECT_NEAR(b.arms[3][190], a.arms[3][190], 1e-6 * a.arms[3][190]);
 
@@ -218,6 +263,10 @@ TEST(Posture, ModelFileRoundTripAndErrors) {
   expect_error(replaced("\"phi_bins\":8", "\"phi_bins\":24"), "rest.bins");
   expect_error(replaced("\"rule\": \"centroids\"", "\"rule\": \"nearest\""), "rule");
   expect_error(replaced("\"iterations\": 3", "\"iterations\": 0"), "iterations");
+  expect_error(replaced("\"pair_rest_state\": false", "\"pair_rest_state\": 1"), "pair_rest_state");
+  // A file from before the key: the weights alone decide.
+  std::ofstream(dir / "old.json") << replaced("\"pair_rest_state\": false,\n ", "");
+  EXPECT_FALSE(PostureAtoms::Load(dir / "old.json").pair_rest_state);
   std::filesystem::remove_all(dir);
 }
 
