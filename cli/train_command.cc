@@ -259,6 +259,11 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   gestures_cmd->add_option("--seed", gesture_args->job.options.seed, "seed of the EM starts")
       ->capture_default_str()
       ->transform(Uint64Text());
+  gestures_cmd->add_option("--raised-arms-scale", gesture_args->job.options.raised_arms_scale,
+                           "the HMM's and FHMM's observation also holds the recognised pair's count of\n"
+                           "raised arms times this (0: the atom weights alone; docs/recognition.md)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   gestures_cmd->add_flag("--retrack", gesture_args->job.retrack,
                          "track every session here even when its track/ was made with these posture atoms");
   gestures_cmd->add_option("--table", gesture_args->table, "also write the tables as Markdown to this file");

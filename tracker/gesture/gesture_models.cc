@@ -17,14 +17,20 @@ namespace {
 
 
 
-Eigen::MatrixXd Observations(const std::vector<GestureObservation>& segment, int dimension) {
+// The Gaussian models' observations: each frame's atom weights, then its
+// pair's raised-arm count times `raised_arms_scale` when that is > 0.
+Eigen::MatrixXd Observations(const std::vector<GestureObservation>& segment, int atoms, double raised_arms_scale) {
+  const int dimension = atoms + (raised_arms_scale > 0 ? 1 : 0);
   Eigen::MatrixXd y(dimension, segment.size());
   for (size_t t = 0; t < segment.size(); ++t) {
-    if (segment[t].weights.size() != dimension) {
+    if (segment[t].weights.size() != atoms) {
       throw std::invalid_argument("an observation of " + std::to_string(segment[t].weights.size()) +
-                                  " weights; the models take " + std::to_string(dimension));
+                                  " weights; the models take " + std::to_string(atoms));
     }
-    y.col(t) = segment[t].weights;
+    y.col(t).head(atoms) = segment[t].weights;
+    if (dimension > atoms) {
+      y(atoms, t) = raised_arms_scale * ((segment[t].primary != 0) + (segment[t].secondary != 0));
+    }
   }
   return y;
 }
@@ -180,13 +186,19 @@ std::optional<GestureModelKind> ParseGestureModelKind(const std::string& name) {
   return std::nullopt;
 }
 
+Eigen::VectorXd GestureModels::ObservationVector(const GestureObservation& o) const {
+  return Observations({o}, atom_count(), raised_arms_scale).col(0);
+}
+
 double GestureModels::LogLikelihood(GestureModelKind kind, int g, const std::vector<GestureObservation>& segment) const {
   switch (kind) {
-    case GestureModelKind::kHmm: return hmm.at(g).LogLikelihood(Observations(segment, dimension()));
-    case GestureModelKind::kFactorialHmm: return fhmm.at(g).LogLikelihood(Observations(segment, dimension()));
+    case GestureModelKind::kHmm:
+      return hmm.at(g).LogLikelihood(Observations(segment, atom_count(), raised_arms_scale));
+    case GestureModelKind::kFactorialHmm:
+      return fhmm.at(g).LogLikelihood(Observations(segment, atom_count(), raised_arms_scale));
     case GestureModelKind::kParallelHmm:
-      return pahmm.at(g)[0].LogLikelihood(Symbols(segment, true, dimension())) +
-             pahmm.at(g)[1].LogLikelihood(Symbols(segment, false, dimension()));
+      return pahmm.at(g)[0].LogLikelihood(Symbols(segment, true, atom_count())) +
+             pahmm.at(g)[1].LogLikelihood(Symbols(segment, false, atom_count()));
   }
   return kLogZero;
 }
@@ -210,15 +222,19 @@ GestureModels GestureModels::Train(const std::vector<std::string>& gestures, con
   if (options.chain_states != static_cast<int>(atoms.size())) {
     throw std::invalid_argument("the PaHMM's chains have one state per atom");
   }
+  if (!(options.raised_arms_scale >= 0) || !std::isfinite(options.raised_arms_scale)) {
+    throw std::invalid_argument("the raised-arm count's scale must be finite and >= 0");
+  }
   GestureModels m;
   m.gestures = gestures;
   m.atoms = atoms;
+  m.raised_arms_scale = options.raised_arms_scale;
   for (size_t g = 0; g < gestures.size(); ++g) {
     std::vector<Eigen::MatrixXd> y;
     std::vector<std::vector<int>> primary, secondary;
     for (const auto& segment : segments[g]) {
       if (segment.empty()) continue;
-      y.push_back(Observations(segment, static_cast<int>(atoms.size())));
+      y.push_back(Observations(segment, static_cast<int>(atoms.size()), options.raised_arms_scale));
       primary.push_back(Symbols(segment, true, static_cast<int>(atoms.size())));
       secondary.push_back(Symbols(segment, false, static_cast<int>(atoms.size())));
     }
@@ -242,6 +258,7 @@ void GestureModels::Save(const std::filesystem::path& path) const {
   j["provenance"] = provenance;
   j["gestures"] = gestures;
   j["atoms"] = atoms;
+  j["raised_arms_scale"] = raised_arms_scale;
   j["models"] = nlohmann::json::array();
   for (int g = 0; g < gesture_count(); ++g) {
     nlohmann::json f = {{"chains", nlohmann::json::array()}, {"weights", nlohmann::json::array()},
@@ -271,15 +288,21 @@ void GestureModels::Save(const std::filesystem::path& path) const {
 
 GestureModels GestureModels::Load(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
-  root.CheckKeys({"format", "provenance", "gestures", "atoms", "models"});
+  root.CheckKeys({"format", "provenance", "gestures", "atoms", "raised_arms_scale", "models"});
   if (root.GetString("format") != kFormat) {
     root["format"].Fail("must be " + std::string(kFormat) + " (got " + root.GetString("format") + ")");
   }
   GestureModels m;
   for (size_t i = 0; i < root["gestures"].Size(); ++i) m.gestures.push_back(root["gestures"][i].String());
   for (size_t i = 0; i < root["atoms"].Size(); ++i) m.atoms.push_back(root["atoms"][i].String());
+  if (m.atom_count() < 2) root["atoms"].Fail("needs at least two atoms");
+  // Files from before the key observe the weights alone.
+  m.raised_arms_scale = root.GetDouble("raised_arms_scale", 0.0);
+  if (!(m.raised_arms_scale >= 0) || !std::isfinite(m.raised_arms_scale)) {
+    root["raised_arms_scale"].Fail("must be finite and >= 0");
+  }
   const int d = m.dimension();
-  if (d < 2) root["atoms"].Fail("needs at least two atoms");
+  const int atoms = m.atom_count();
   if (m.gestures.empty()) root["gestures"].Fail("needs at least one gesture");
   const JsonNode models = root["models"];
   if (models.Size() != m.gestures.size()) models.Fail("needs one entry per gesture");
@@ -300,9 +323,9 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
     std::array<DiscreteHmm, 2> pa;
     for (size_t c = 0; c < 2; ++c) {
       p[c].CheckKeys({"chain", "emission"});
-      pa[c].chain = ChainFrom(p[c]["chain"], d);
-      const Eigen::MatrixXd b = p[c]["emission"].FiniteMatrix(d, d);
-      for (int i = 0; i < d; ++i) {
+      pa[c].chain = ChainFrom(p[c]["chain"], atoms);
+      const Eigen::MatrixXd b = p[c]["emission"].FiniteMatrix(atoms, atoms);
+      for (int i = 0; i < atoms; ++i) {
         if ((b.row(i).array() < 0).any() || std::abs(b.row(i).sum() - 1) > 1e-6) {
           p[c]["emission"][i].Fail("must be probabilities summing to 1");
         }

@@ -9,6 +9,11 @@
 //          likelihood their product (Eq. 5.13), starting at rest;
 //   fhmm   the factorial HMM (5.2.2): 2 chains x 5 states, the weight vector
 //          Gaussian with mean W_1 S_1 + W_2 S_2 and a full covariance.
+// The Gaussian models' observation is the atom weights and, when the models
+// were trained with it (raised_arms_scale > 0), the recognised pair's count
+// of raised arms (its atoms other than A0: 0-2) times that scale: the count
+// the pose tracker's rest state fixes (posture_atoms.h, pair_rest_state),
+// which tells one arm in an atom from two far better than their weights.
 // A segment is recognised as the gesture whose model gives it the highest
 // likelihood (equal priors, Eq. 5.12). Stored as irbench.gesture-models/1
 // (JSON) with how it was made.
@@ -45,6 +50,11 @@ struct GestureTrainingOptions {
   int max_iterations = 60;
   double covariance_ridge = 1e-3;  // added to the Gaussian models' covariance diagonal
   double pseudo_count = 0.5;       // the PaHMM's Dirichlet counts (unseen symbols stay possible)
+  // The raised-arm count's scale in the Gaussian models' observation; 0:
+  // not observed. Its spread within a state is the covariance ridge's, so
+  // the scale sets what one frame whose count disagrees costs:
+  // scale^2 / (2 ridge) nats.
+  double raised_arms_scale = 0;
   uint64_t seed = 1;
 };
 
@@ -53,13 +63,21 @@ struct GestureModels {
 
   std::vector<std::string> gestures;
   std::vector<std::string> atoms;  // the posture atoms' names (the observation's order)
+  double raised_arms_scale = 0;    // > 0: the observation ends with the scaled raised-arm count
   std::vector<GaussianHmm> hmm;
   std::vector<std::array<DiscreteHmm, 2>> pahmm;  // primary, secondary
   std::vector<Fhmm> fhmm;
   nlohmann::json provenance;
 
   int gesture_count() const { return static_cast<int>(gestures.size()); }
-  int dimension() const { return static_cast<int>(atoms.size()); }
+  int atom_count() const { return static_cast<int>(atoms.size()); }
+  // The Gaussian models' observation size: the atoms' weights, then the
+  // raised-arm count when observed.
+  int dimension() const { return atom_count() + (raised_arms_scale > 0 ? 1 : 0); }
+
+  // One frame's observation as the Gaussian models read it (dimension()
+  // values). Throws std::invalid_argument for weights of another size.
+  Eigen::VectorXd ObservationVector(const GestureObservation& o) const;
 
   // log p(segment | gesture g's model of `kind`). Throws std::invalid_argument
   // for an observation of another dimension or atom index.

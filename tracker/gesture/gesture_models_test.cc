@@ -117,6 +117,83 @@ TEST(GestureModels, FileRoundTripKeepsTheLikelihoodsAndBadFilesAreNamed) {
   std::filesystem::remove_all(dir);
 }
 
+// Two gestures whose weights agree: one arm raised into A1, and both arms
+// into A1 where two arms weigh what one does (the tracker's hulls: 1.3-1.8
+// rather than 2). Only the pair's count of raised arms, which the pose
+// tracker's rest state fixes, tells them apart.
+std::vector<GestureObservation> RaiseInto(int arms, std::mt19937_64& rng) {
+  std::vector<GestureObservation> out = Perform({{0, 0}, {1, 0}, {1, 0}, {0, 0}}, rng);
+  for (GestureObservation& o : out) {
+    if (o.primary != 0) o.secondary = arms == 2 ? o.primary : 0;
+  }
+  return out;
+}
+
+TEST(GestureModels, TheRaisedArmCountTellsOneArmFromTwo) {
+  std::mt19937_64 rng(8);
+  std::vector<std::vector<std::vector<GestureObservation>>> segments(2);
+  for (int r = 0; r < 6; ++r) {
+    segments[0].push_back(RaiseInto(1, rng));
+    segments[1].push_back(RaiseInto(2, rng));
+  }
+  GestureTrainingOptions options;
+  options.max_iterations = 25;
+  options.restarts = 2;
+  const GestureModels alone = GestureModels::Train({"one", "two"}, kAtoms, segments, options);
+  options.raised_arms_scale = 0.1;
+  const GestureModels counted = GestureModels::Train({"one", "two"}, kAtoms, segments, options);
+  EXPECT_EQ(alone.dimension(), 5);
+  EXPECT_EQ(counted.dimension(), 6);
+  // The observation: the weights, then 0.1 x the raised arms.
+  const GestureObservation& raised = segments[1][0][segments[1][0].size() / 2];
+  ASSERT_NE(raised.primary, 0);
+  const Eigen::VectorXd v = counted.ObservationVector(raised);
+  EXPECT_EQ(v.head(5), raised.weights);
+  EXPECT_DOUBLE_EQ(v(5), 0.1 * (1 + (raised.secondary != 0)));
+  for (GestureModelKind kind : {GestureModelKind::kHmm, GestureModelKind::kFactorialHmm}) {
+    int right_alone = 0, right_counted = 0, total = 0;
+    for (int r = 0; r < 10; ++r) {
+      for (int arms = 1; arms <= 2; ++arms) {
+        const std::vector<GestureObservation> seg = RaiseInto(arms, rng);
+        right_alone += alone.Classify(kind, seg) == arms - 1;
+        right_counted += counted.Classify(kind, seg) == arms - 1;
+        ++total;
+      }
+    }
+    EXPECT_EQ(right_counted, total) << GestureModelKindName(kind);
+    EXPECT_LE(right_alone, total * 3 / 4) << GestureModelKindName(kind);
+  }
+  // The scale survives the file, and the online recogniser reads it.
+  const auto dir = std::filesystem::temp_directory_path() / "irbench_gesture_models_raised";
+  std::filesystem::create_directories(dir);
+  counted.Save(dir / "m.json");
+  auto back = std::make_shared<GestureModels>(GestureModels::Load(dir / "m.json"));
+  EXPECT_DOUBLE_EQ(back->raised_arms_scale, 0.1);
+  const std::vector<GestureObservation> seg = RaiseInto(2, rng);
+  GestureRecognizer online(back, GestureModelKind::kFactorialHmm, {1});
+  std::optional<GestureDecision> d;
+  for (size_t t = 0; t < seg.size(); ++t) d = online.Update(static_cast<int>(t), seg[t], false);
+  ASSERT_TRUE(d);
+  std::vector<double> batch;
+  EXPECT_EQ(d->gesture, back->Classify(GestureModelKind::kFactorialHmm, seg, &batch));
+  EXPECT_EQ(d->gesture, 1);
+  for (int g = 0; g < 2; ++g) EXPECT_NEAR(online.log_likelihoods()[g], batch[g], 1e-6 * std::abs(batch[g]));
+  std::ofstream(dir / "bad.json") << [&] {
+    std::ifstream in(dir / "m.json");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key = "\"raised_arms_scale\": 0.1";
+    EXPECT_NE(text.find(key), std::string::npos);
+    return text.replace(text.find(key), key.size(), "\"raised_arms_scale\": -1");
+  }();
+  try {
+    GestureModels::Load(dir / "bad.json");
+    ADD_FAILURE() << "no error for a negative scale";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "raised_arms_scale") << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // Online, frame by frame, the recogniser's log-likelihoods equal the batch
 // ones of the segment seen so far (the last frame at rest first), and its
 // decision is the batch classification.

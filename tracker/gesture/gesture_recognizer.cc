@@ -43,7 +43,7 @@ Eigen::VectorXd GestureRecognizer::EmissionOf(const Stream& s, const GestureObse
     if (symbol < 0 || symbol >= s.log_emission.cols()) throw std::invalid_argument("an atom outside the models'");
     return s.log_emission.col(symbol);
   }
-  return GaussianLogDensities(o.weights, s.means, s.covariance).row(0).transpose();
+  return GaussianLogDensities(models_->ObservationVector(o), s.means, s.covariance).row(0).transpose();
 }
 
 void GestureRecognizer::Advance(const GestureObservation& o) {
