@@ -79,7 +79,7 @@ int RunTrainAtoms(const CLI::App& cmd, TrainAtomsArgs& args) {
 struct TrainGesturesArgs {
   GestureTrainingJob job;
   std::vector<std::string> train, test;
-  std::string atoms, out, table;
+  std::string atoms, out, table, observation = "pair";
 };
 
 int RunTrainGestures(const CLI::App& cmd, TrainGesturesArgs& args) {
@@ -90,6 +90,7 @@ int RunTrainGestures(const CLI::App& cmd, TrainGesturesArgs& args) {
   job.posture_atoms = args.atoms;
   job.out = args.out;
   job.table = args.table;
+  job.options.observation = *ParseGestureObservationKind(args.observation);
   const GestureTrainingResult r = RunGestureTraining(job);
   std::cout << "gesture models: " << r.segments << " training segments\n";
   if (!r.evaluation.counts.empty()) {
@@ -259,11 +260,15 @@ std::vector<Command> AddTrainCommand(CLI::App& app) {
   gestures_cmd->add_option("--seed", gesture_args->job.options.seed, "seed of the EM starts")
       ->capture_default_str()
       ->transform(Uint64Text());
-  gestures_cmd->add_option("--raised-arms-scale", gesture_args->job.options.raised_arms_scale,
-                           "the HMM's and FHMM's observation also holds the recognised pair's count of\n"
-                           "raised arms times this (0: the atom weights alone; docs/recognition.md)")
+  gestures_cmd->add_option("--observation", gesture_args->observation,
+                           "what the HMM and FHMM observe: weights (the atom weights, the thesis's) or pair\n"
+                           "(the recognised pair as weights, --pair-scale per arm on its atoms)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(CLI::IsMember({"weights", "pair"}));
+  gestures_cmd->add_option("--pair-scale", gesture_args->job.options.pair_scale,
+                           "with --observation pair: one arm's weight on its atom")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 100.0));
   gestures_cmd->add_flag("--retrack", gesture_args->job.retrack,
                          "track every session here even when its track/ was made with these posture atoms");
   gestures_cmd->add_option("--table", gesture_args->table, "also write the tables as Markdown to this file");

@@ -325,7 +325,8 @@ GestureTrainingResult RunGestureTraining(const GestureTrainingJob& job) {
                          {"max_iterations", job.options.max_iterations},
                          {"covariance_ridge", job.options.covariance_ridge},
                          {"pseudo_count", job.options.pseudo_count},
-                         {"raised_arms_scale", job.options.raised_arms_scale},
+                         {"observation", GestureObservationKindName(job.options.observation)},
+                         {"pair_scale", job.options.pair_scale},
                          {"seed", job.options.seed}}}};
   result.model = job.out.empty() ? DefaultGestureModelsPath() : job.out;
   models.Save(result.model);

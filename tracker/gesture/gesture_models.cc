@@ -17,20 +17,27 @@ namespace {
 
 
 
-// The Gaussian models' observations: each frame's atom weights, then its
-// pair's raised-arm count times `raised_arms_scale` when that is > 0.
-Eigen::MatrixXd Observations(const std::vector<GestureObservation>& segment, int atoms, double raised_arms_scale) {
-  const int dimension = atoms + (raised_arms_scale > 0 ? 1 : 0);
-  Eigen::MatrixXd y(dimension, segment.size());
+// The Gaussian models' observations, one column per frame: its atom weights,
+// or its pair as weights (pair_scale per arm on the pair's atoms).
+Eigen::MatrixXd Observations(const std::vector<GestureObservation>& segment, int atoms, GestureObservationKind kind,
+                             double pair_scale) {
+  Eigen::MatrixXd y(atoms, segment.size());
   for (size_t t = 0; t < segment.size(); ++t) {
-    if (segment[t].weights.size() != atoms) {
-      throw std::invalid_argument("an observation of " + std::to_string(segment[t].weights.size()) +
+    const GestureObservation& o = segment[t];
+    if (kind == GestureObservationKind::kPair) {
+      if (o.primary < 0 || o.primary >= atoms || o.secondary < 0 || o.secondary >= atoms) {
+        throw std::invalid_argument("an atom index outside the models' atoms");
+      }
+      y.col(t).setZero();
+      y(o.primary, t) += pair_scale;
+      y(o.secondary, t) += pair_scale;
+      continue;
+    }
+    if (o.weights.size() != atoms) {
+      throw std::invalid_argument("an observation of " + std::to_string(o.weights.size()) +
                                   " weights; the models take " + std::to_string(atoms));
     }
-    y.col(t).head(atoms) = segment[t].weights;
-    if (dimension > atoms) {
-      y(atoms, t) = raised_arms_scale * ((segment[t].primary != 0) + (segment[t].secondary != 0));
-    }
+    y.col(t) = o.weights;
   }
   return y;
 }
@@ -179,6 +186,16 @@ const char* GestureModelKindName(GestureModelKind kind) {
   return "";
 }
 
+const char* GestureObservationKindName(GestureObservationKind kind) {
+  return kind == GestureObservationKind::kPair ? "pair" : "weights";
+}
+
+std::optional<GestureObservationKind> ParseGestureObservationKind(const std::string& name) {
+  if (name == "weights") return GestureObservationKind::kWeights;
+  if (name == "pair") return GestureObservationKind::kPair;
+  return std::nullopt;
+}
+
 std::optional<GestureModelKind> ParseGestureModelKind(const std::string& name) {
   for (GestureModelKind k : {GestureModelKind::kHmm, GestureModelKind::kParallelHmm, GestureModelKind::kFactorialHmm}) {
     if (name == GestureModelKindName(k)) return k;
@@ -187,15 +204,15 @@ std::optional<GestureModelKind> ParseGestureModelKind(const std::string& name) {
 }
 
 Eigen::VectorXd GestureModels::ObservationVector(const GestureObservation& o) const {
-  return Observations({o}, atom_count(), raised_arms_scale).col(0);
+  return Observations({o}, atom_count(), observation, pair_scale).col(0);
 }
 
 double GestureModels::LogLikelihood(GestureModelKind kind, int g, const std::vector<GestureObservation>& segment) const {
   switch (kind) {
     case GestureModelKind::kHmm:
-      return hmm.at(g).LogLikelihood(Observations(segment, atom_count(), raised_arms_scale));
+      return hmm.at(g).LogLikelihood(Observations(segment, atom_count(), observation, pair_scale));
     case GestureModelKind::kFactorialHmm:
-      return fhmm.at(g).LogLikelihood(Observations(segment, atom_count(), raised_arms_scale));
+      return fhmm.at(g).LogLikelihood(Observations(segment, atom_count(), observation, pair_scale));
     case GestureModelKind::kParallelHmm:
       return pahmm.at(g)[0].LogLikelihood(Symbols(segment, true, atom_count())) +
              pahmm.at(g)[1].LogLikelihood(Symbols(segment, false, atom_count()));
@@ -222,19 +239,20 @@ GestureModels GestureModels::Train(const std::vector<std::string>& gestures, con
   if (options.chain_states != static_cast<int>(atoms.size())) {
     throw std::invalid_argument("the PaHMM's chains have one state per atom");
   }
-  if (!(options.raised_arms_scale >= 0) || !std::isfinite(options.raised_arms_scale)) {
-    throw std::invalid_argument("the raised-arm count's scale must be finite and >= 0");
+  if (!(options.pair_scale > 0) || !std::isfinite(options.pair_scale)) {
+    throw std::invalid_argument("the pair observation's scale must be finite and > 0");
   }
   GestureModels m;
   m.gestures = gestures;
   m.atoms = atoms;
-  m.raised_arms_scale = options.raised_arms_scale;
+  m.observation = options.observation;
+  m.pair_scale = options.pair_scale;
   for (size_t g = 0; g < gestures.size(); ++g) {
     std::vector<Eigen::MatrixXd> y;
     std::vector<std::vector<int>> primary, secondary;
     for (const auto& segment : segments[g]) {
       if (segment.empty()) continue;
-      y.push_back(Observations(segment, static_cast<int>(atoms.size()), options.raised_arms_scale));
+      y.push_back(Observations(segment, static_cast<int>(atoms.size()), options.observation, options.pair_scale));
       primary.push_back(Symbols(segment, true, static_cast<int>(atoms.size())));
       secondary.push_back(Symbols(segment, false, static_cast<int>(atoms.size())));
     }
@@ -258,7 +276,8 @@ void GestureModels::Save(const std::filesystem::path& path) const {
   j["provenance"] = provenance;
   j["gestures"] = gestures;
   j["atoms"] = atoms;
-  j["raised_arms_scale"] = raised_arms_scale;
+  j["observation"] = GestureObservationKindName(observation);
+  if (observation == GestureObservationKind::kPair) j["pair_scale"] = pair_scale;
   j["models"] = nlohmann::json::array();
   for (int g = 0; g < gesture_count(); ++g) {
     nlohmann::json f = {{"chains", nlohmann::json::array()}, {"weights", nlohmann::json::array()},
@@ -288,7 +307,7 @@ void GestureModels::Save(const std::filesystem::path& path) const {
 
 GestureModels GestureModels::Load(const std::filesystem::path& path) {
   const JsonNode root = ParseJsonFile(path.string());
-  root.CheckKeys({"format", "provenance", "gestures", "atoms", "raised_arms_scale", "models"});
+  root.CheckKeys({"format", "provenance", "gestures", "atoms", "observation", "pair_scale", "models"});
   if (root.GetString("format") != kFormat) {
     root["format"].Fail("must be " + std::string(kFormat) + " (got " + root.GetString("format") + ")");
   }
@@ -296,10 +315,14 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
   for (size_t i = 0; i < root["gestures"].Size(); ++i) m.gestures.push_back(root["gestures"][i].String());
   for (size_t i = 0; i < root["atoms"].Size(); ++i) m.atoms.push_back(root["atoms"][i].String());
   if (m.atom_count() < 2) root["atoms"].Fail("needs at least two atoms");
-  // Files from before the key observe the weights alone.
-  m.raised_arms_scale = root.GetDouble("raised_arms_scale", 0.0);
-  if (!(m.raised_arms_scale >= 0) || !std::isfinite(m.raised_arms_scale)) {
-    root["raised_arms_scale"].Fail("must be finite and >= 0");
+  // Files from before the key observe the weights.
+  const std::string observation = root.GetString("observation", "weights");
+  const std::optional<GestureObservationKind> kind = ParseGestureObservationKind(observation);
+  if (!kind) root["observation"].Fail("must be weights or pair (got " + observation + ")");
+  m.observation = *kind;
+  if (m.observation == GestureObservationKind::kPair) {
+    m.pair_scale = root.GetDouble("pair_scale");
+    if (!(m.pair_scale > 0) || !std::isfinite(m.pair_scale)) root["pair_scale"].Fail("must be finite and > 0");
   }
   const int d = m.dimension();
   const int atoms = m.atom_count();

@@ -86,6 +86,8 @@ TEST(GestureModels, FileRoundTripKeepsTheLikelihoodsAndBadFilesAreNamed) {
   const GestureModels back = GestureModels::Load(dir / "m.json");
   EXPECT_EQ(back.gestures, models.gestures);
   EXPECT_EQ(back.provenance, models.provenance);
+  EXPECT_EQ(back.observation, GestureObservationKind::kPair);  // the default
+  EXPECT_EQ(back.pair_scale, models.pair_scale);
   const std::vector<GestureObservation> segment = Perform(kScripts[1], rng);
   for (GestureModelKind kind : {GestureModelKind::kHmm, GestureModelKind::kParallelHmm, GestureModelKind::kFactorialHmm}) {
     for (int g = 0; g < 3; ++g) {
@@ -119,8 +121,8 @@ TEST(GestureModels, FileRoundTripKeepsTheLikelihoodsAndBadFilesAreNamed) {
 
 // Two gestures whose weights agree: one arm raised into A1, and both arms
 // into A1 where two arms weigh what one does (the tracker's hulls: 1.3-1.8
-// rather than 2). Only the pair's count of raised arms, which the pose
-// tracker's rest state fixes, tells them apart.
+// rather than 2). Only the recognised pair, whose count of arms at rest the
+// pose tracker's rest state fixes, tells them apart.
 std::vector<GestureObservation> RaiseInto(int arms, std::mt19937_64& rng) {
   std::vector<GestureObservation> out = Perform({{0, 0}, {1, 0}, {1, 0}, {0, 0}}, rng);
   for (GestureObservation& o : out) {
@@ -129,7 +131,7 @@ std::vector<GestureObservation> RaiseInto(int arms, std::mt19937_64& rng) {
   return out;
 }
 
-TEST(GestureModels, TheRaisedArmCountTellsOneArmFromTwo) {
+TEST(GestureModels, ThePairObservationTellsOneArmFromTwo) {
   std::mt19937_64 rng(8);
   std::vector<std::vector<std::vector<GestureObservation>>> segments(2);
   for (int r = 0; r < 6; ++r) {
@@ -139,36 +141,39 @@ TEST(GestureModels, TheRaisedArmCountTellsOneArmFromTwo) {
   GestureTrainingOptions options;
   options.max_iterations = 25;
   options.restarts = 2;
-  const GestureModels alone = GestureModels::Train({"one", "two"}, kAtoms, segments, options);
-  options.raised_arms_scale = 0.1;
-  const GestureModels counted = GestureModels::Train({"one", "two"}, kAtoms, segments, options);
-  EXPECT_EQ(alone.dimension(), 5);
-  EXPECT_EQ(counted.dimension(), 6);
-  // The observation: the weights, then 0.1 x the raised arms.
+  options.observation = GestureObservationKind::kWeights;
+  const GestureModels weights = GestureModels::Train({"one", "two"}, kAtoms, segments, options);
+  options.observation = GestureObservationKind::kPair;
+  options.pair_scale = 0.2;
+  const GestureModels pair = GestureModels::Train({"one", "two"}, kAtoms, segments, options);
+  // The observation: pair_scale per arm on the pair's atoms.
   const GestureObservation& raised = segments[1][0][segments[1][0].size() / 2];
   ASSERT_NE(raised.primary, 0);
-  const Eigen::VectorXd v = counted.ObservationVector(raised);
-  EXPECT_EQ(v.head(5), raised.weights);
-  EXPECT_DOUBLE_EQ(v(5), 0.1 * (1 + (raised.secondary != 0)));
+  Eigen::VectorXd expected = Eigen::VectorXd::Zero(5);
+  expected(raised.primary) += 0.2;
+  expected(raised.secondary) += 0.2;
+  EXPECT_EQ(pair.ObservationVector(raised), expected);
+  EXPECT_EQ(weights.ObservationVector(raised), raised.weights);
   for (GestureModelKind kind : {GestureModelKind::kHmm, GestureModelKind::kFactorialHmm}) {
-    int right_alone = 0, right_counted = 0, total = 0;
+    int right_weights = 0, right_pair = 0, total = 0;
     for (int r = 0; r < 10; ++r) {
       for (int arms = 1; arms <= 2; ++arms) {
         const std::vector<GestureObservation> seg = RaiseInto(arms, rng);
-        right_alone += alone.Classify(kind, seg) == arms - 1;
-        right_counted += counted.Classify(kind, seg) == arms - 1;
+        right_weights += weights.Classify(kind, seg) == arms - 1;
+        right_pair += pair.Classify(kind, seg) == arms - 1;
         ++total;
       }
     }
-    EXPECT_EQ(right_counted, total) << GestureModelKindName(kind);
-    EXPECT_LE(right_alone, total * 3 / 4) << GestureModelKindName(kind);
+    EXPECT_EQ(right_pair, total) << GestureModelKindName(kind);
+    EXPECT_LE(right_weights, total * 3 / 4) << GestureModelKindName(kind);
   }
-  // The scale survives the file, and the online recogniser reads it.
-  const auto dir = std::filesystem::temp_directory_path() / "irbench_gesture_models_raised";
+  // The kind and scale survive the file, and the online recogniser reads them.
+  const auto dir = std::filesystem::temp_directory_path() / "irbench_gesture_models_pair";
   std::filesystem::create_directories(dir);
-  counted.Save(dir / "m.json");
+  pair.Save(dir / "m.json");
   auto back = std::make_shared<GestureModels>(GestureModels::Load(dir / "m.json"));
-  EXPECT_DOUBLE_EQ(back->raised_arms_scale, 0.1);
+  EXPECT_EQ(back->observation, GestureObservationKind::kPair);
+  EXPECT_DOUBLE_EQ(back->pair_scale, 0.2);
   const std::vector<GestureObservation> seg = RaiseInto(2, rng);
   GestureRecognizer online(back, GestureModelKind::kFactorialHmm, {1});
   std::optional<GestureDecision> d;
@@ -178,19 +183,30 @@ TEST(GestureModels, TheRaisedArmCountTellsOneArmFromTwo) {
   EXPECT_EQ(d->gesture, back->Classify(GestureModelKind::kFactorialHmm, seg, &batch));
   EXPECT_EQ(d->gesture, 1);
   for (int g = 0; g < 2; ++g) EXPECT_NEAR(online.log_likelihoods()[g], batch[g], 1e-6 * std::abs(batch[g]));
-  std::ofstream(dir / "bad.json") << [&] {
-    std::ifstream in(dir / "m.json");
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string key = "\"raised_arms_scale\": 0.1";
-    EXPECT_NE(text.find(key), std::string::npos);
-    return text.replace(text.find(key), key.size(), "\"raised_arms_scale\": -1");
-  }();
-  try {
-    GestureModels::Load(dir / "bad.json");
-    ADD_FAILURE() << "no error for a negative scale";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), "raised_arms_scale") << e.what();
+  std::ifstream in(dir / "m.json");
+  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto expect_error = [&](const std::string& from, const std::string& to, const std::string& field) {
+    std::string text = good;
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    std::ofstream(dir / "bad.json") << text.replace(at, from.size(), to);
+    try {
+      GestureModels::Load(dir / "bad.json");
+      ADD_FAILURE() << "no error for " << field;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), field) << e.what();
+    }
+  };
+  expect_error("\"pair_scale\": 0.2", "\"pair_scale\": -1", "pair_scale");
+  expect_error("\"observation\": \"pair\"", "\"observation\": \"poses\"", "observation");
+  // A file from before the keys observes the weights.
+  std::string old = good;
+  for (const std::string key : {"\"observation\": \"pair\",\n ", "\"pair_scale\": 0.2,\n "}) {
+    ASSERT_NE(old.find(key), std::string::npos) << key;
+    old.erase(old.find(key), key.size());
   }
+  std::ofstream(dir / "old.json") << old;
+  EXPECT_EQ(GestureModels::Load(dir / "old.json").observation, GestureObservationKind::kWeights);
   std::filesystem::remove_all(dir);
 }
 
