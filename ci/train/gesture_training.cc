@@ -1,6 +1,7 @@
 #include "ci/train/gesture_training.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <sstream>
 
@@ -38,24 +39,46 @@ constexpr double kThesisHmm[6][5] = {{37.5, 50, 76.9, 44, 80.0},  {87.5, 87.5, 1
                                      {88.8, 88.8, 100, 100, 100}, {22.2, 22.2, 11.1, 7.8, 0}};
 
 // A sequence as the tracker saw it: per frame its posture (or none) and
-// the truth's gesture spans.
+// whether its arms are at rest, and the truth's gesture spans.
 struct TrackedSession {
   std::string person;
   std::string track;  // where the tracker's output came from
   std::vector<std::optional<GestureObservation>> frames;
+  std::vector<bool> at_rest;  // as the online recogniser reads it (FrameTracker)
   struct Span {
     int gesture, first, last;
   };
   std::vector<Span> spans;
 
+  // A span's frames as the online recogniser cuts a performance: from the
+  // last frame at rest before its first frame with an arm raised to its
+  // last such frame (the truth's span also holds the rest before and after
+  // a performance, which the recogniser never sees); the whole span when no
+  // arm is raised in it.
   std::vector<GestureObservation> Segment(const Span& s) const {
+    const int n = static_cast<int>(frames.size());
+    int first = std::max(0, s.first), last = std::min(s.last, n - 1);
+    int raised_first = -1, raised_last = -1;
+    for (int f = first; f <= last; ++f) {
+      if (at_rest[f]) continue;
+      if (raised_first < 0) raised_first = f;
+      raised_last = f;
+    }
+    if (raised_first >= 0) first = std::max(0, raised_first - 1), last = raised_last;
     std::vector<GestureObservation> out;
-    for (int f = std::max(0, s.first); f <= s.last && f < static_cast<int>(frames.size()); ++f) {
+    for (int f = first; f <= last; ++f) {
       if (frames[f]) out.push_back(*frames[f]);
     }
     return out;
   }
 };
+
+// Both arms at rest as FrameTracker tells the online recogniser: by the
+// rest-state classifier, or where it has no answer by the recognised pair.
+bool AtRest(const std::array<std::optional<bool>, 2>& rest, const std::optional<GestureObservation>& posture) {
+  if (rest[0] && rest[1]) return *rest[0] && *rest[1];
+  return posture && posture->primary == 0 && posture->secondary == 0;
+}
 
 // The truth's gesture spans of a rendered session.
 std::vector<TrackedSession::Span> GestureSpans(const fs::path& dir) {
@@ -114,7 +137,16 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::stri
                   : ReadExistingTrack(dir, manifest.frame_count, {{"posture_atoms", atoms_sha256}}, &miss)) {
     Log().info("train gestures: {}: using its track/", dir.filename().string());
     s.track = "track/";
-    for (const nlohmann::json& line : existing->lines) s.frames.push_back(PostureOfTrackLine(line, atom_model));
+    for (const nlohmann::json& line : existing->lines) {
+      s.frames.push_back(PostureOfTrackLine(line, atom_model));
+      std::array<std::optional<bool>, 2> rest;
+      if (line.contains("rest") && line["rest"].is_object()) {
+        const nlohmann::json& r = line["rest"];
+        if (r.contains("right") && r["right"].is_boolean()) rest[0] = r["right"].get<bool>();
+        if (r.contains("left") && r["left"].is_boolean()) rest[1] = r["left"].get<bool>();
+      }
+      s.at_rest.push_back(AtRest(rest, s.frames.back()));
+    }
     return s;
   }
   if (miss == ExistingTrackMiss::kOtherModels) {
@@ -131,8 +163,11 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::stri
     std::vector<std::string> problems;
     const FrameTracker::Step step = tracker.Track(f, input.TryFrameSet(f, &problems), problems, 1.0 / input.fps());
     progress.Set(f + 1, "frame");
+    std::array<std::optional<bool>, 2> rest;
+    if (step.pose) rest = {step.pose->rest[0], step.pose->rest[1]};
     if (!step.posture) {
       s.frames.push_back(std::nullopt);
+      s.at_rest.push_back(AtRest(rest, std::nullopt));
       continue;
     }
     GestureObservation o;
@@ -140,6 +175,7 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::stri
     o.primary = step.posture->pair[1];
     o.secondary = step.posture->pair[0];
     s.frames.push_back(o);
+    s.at_rest.push_back(AtRest(rest, o));
   }
   return s;
 }

@@ -4,7 +4,10 @@
 // (motions/gesture_set.json) and scores them the thesis's way (5.3): every
 // gesture the truth's events mark in a test sequence is one segment, put to
 // each gesture's model; the most likely is the recognised gesture. Table 5.2
-// is the identification rate per gesture and person.
+// is the identification rate per gesture and person. A segment is the
+// truth's span cut as the online recogniser cuts a performance (the last
+// frame at rest before the first with an arm raised, to the last such
+// frame), in training and in testing.
 //
 // Training sees each sequence as the tracker saw it (front end, pose,
 // posture decomposition with the given atoms), errors included; the truth
