@@ -1,7 +1,6 @@
 #include "ci/train/gesture_training.h"
 
 #include <algorithm>
-#include <array>
 #include <cstdio>
 #include <sstream>
 
@@ -14,6 +13,7 @@
 #include "common/progress.h"
 #include "common/sha256.h"
 #include "sequence_format/manifest.h"
+#include "tracker/gesture/gesture_recognizer.h"
 #include "tracker/io/sequence_input.h"
 #include "tracker/pipeline/frame_tracker.h"
 
@@ -72,13 +72,6 @@ struct TrackedSession {
     return out;
   }
 };
-
-// Both arms at rest as FrameTracker tells the online recogniser: by the
-// rest-state classifier, or where it has no answer by the recognised pair.
-bool AtRest(const std::array<std::optional<bool>, 2>& rest, const std::optional<GestureObservation>& posture) {
-  if (rest[0] && rest[1]) return *rest[0] && *rest[1];
-  return posture && posture->primary == 0 && posture->secondary == 0;
-}
 
 // The truth's gesture spans of a rendered session.
 std::vector<TrackedSession::Span> GestureSpans(const fs::path& dir) {
@@ -139,13 +132,13 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::stri
     s.track = "track/";
     for (const nlohmann::json& line : existing->lines) {
       s.frames.push_back(PostureOfTrackLine(line, atom_model));
-      std::array<std::optional<bool>, 2> rest;
+      std::optional<bool> right, left;
       if (line.contains("rest") && line["rest"].is_object()) {
         const nlohmann::json& r = line["rest"];
-        if (r.contains("right") && r["right"].is_boolean()) rest[0] = r["right"].get<bool>();
-        if (r.contains("left") && r["left"].is_boolean()) rest[1] = r["left"].get<bool>();
+        if (r.contains("right") && r["right"].is_boolean()) right = r["right"].get<bool>();
+        if (r.contains("left") && r["left"].is_boolean()) left = r["left"].get<bool>();
       }
-      s.at_rest.push_back(AtRest(rest, s.frames.back()));
+      s.at_rest.push_back(BothArmsAtRest(right, left, s.frames.back()));
     }
     return s;
   }
@@ -163,11 +156,11 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::stri
     std::vector<std::string> problems;
     const FrameTracker::Step step = tracker.Track(f, input.TryFrameSet(f, &problems), problems, 1.0 / input.fps());
     progress.Set(f + 1, "frame");
-    std::array<std::optional<bool>, 2> rest;
-    if (step.pose) rest = {step.pose->rest[0], step.pose->rest[1]};
+    const std::optional<bool> right = step.pose ? step.pose->rest[0] : std::nullopt;
+    const std::optional<bool> left = step.pose ? step.pose->rest[1] : std::nullopt;
     if (!step.posture) {
       s.frames.push_back(std::nullopt);
-      s.at_rest.push_back(AtRest(rest, std::nullopt));
+      s.at_rest.push_back(BothArmsAtRest(right, left, std::nullopt));
       continue;
     }
     GestureObservation o;
@@ -175,7 +168,7 @@ TrackedSession Track(const fs::path& dir, const fs::path& atoms, const std::stri
     o.primary = step.posture->pair[1];
     o.secondary = step.posture->pair[0];
     s.frames.push_back(o);
-    s.at_rest.push_back(AtRest(rest, o));
+    s.at_rest.push_back(BothArmsAtRest(right, left, o));
   }
   return s;
 }

@@ -204,18 +204,18 @@ std::optional<GestureModelKind> ParseGestureModelKind(const std::string& name) {
 }
 
 Eigen::VectorXd GestureModels::ObservationVector(const GestureObservation& o) const {
-  return Observations({o}, atom_count(), observation, pair_scale).col(0);
+  return Observations({o}, dimension(), observation, pair_scale).col(0);
 }
 
 double GestureModels::LogLikelihood(GestureModelKind kind, int g, const std::vector<GestureObservation>& segment) const {
   switch (kind) {
     case GestureModelKind::kHmm:
-      return hmm.at(g).LogLikelihood(Observations(segment, atom_count(), observation, pair_scale));
+      return hmm.at(g).LogLikelihood(Observations(segment, dimension(), observation, pair_scale));
     case GestureModelKind::kFactorialHmm:
-      return fhmm.at(g).LogLikelihood(Observations(segment, atom_count(), observation, pair_scale));
+      return fhmm.at(g).LogLikelihood(Observations(segment, dimension(), observation, pair_scale));
     case GestureModelKind::kParallelHmm:
-      return pahmm.at(g)[0].LogLikelihood(Symbols(segment, true, atom_count())) +
-             pahmm.at(g)[1].LogLikelihood(Symbols(segment, false, atom_count()));
+      return pahmm.at(g)[0].LogLikelihood(Symbols(segment, true, dimension())) +
+             pahmm.at(g)[1].LogLikelihood(Symbols(segment, false, dimension()));
   }
   return kLogZero;
 }
@@ -314,7 +314,7 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
   GestureModels m;
   for (size_t i = 0; i < root["gestures"].Size(); ++i) m.gestures.push_back(root["gestures"][i].String());
   for (size_t i = 0; i < root["atoms"].Size(); ++i) m.atoms.push_back(root["atoms"][i].String());
-  if (m.atom_count() < 2) root["atoms"].Fail("needs at least two atoms");
+  if (m.dimension() < 2) root["atoms"].Fail("needs at least two atoms");
   // Files from before the key observe the weights.
   const std::string observation = root.GetString("observation", "weights");
   const std::optional<GestureObservationKind> kind = ParseGestureObservationKind(observation);
@@ -325,7 +325,6 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
     if (!(m.pair_scale > 0) || !std::isfinite(m.pair_scale)) root["pair_scale"].Fail("must be finite and > 0");
   }
   const int d = m.dimension();
-  const int atoms = m.atom_count();
   if (m.gestures.empty()) root["gestures"].Fail("needs at least one gesture");
   const JsonNode models = root["models"];
   if (models.Size() != m.gestures.size()) models.Fail("needs one entry per gesture");
@@ -346,9 +345,9 @@ GestureModels GestureModels::Load(const std::filesystem::path& path) {
     std::array<DiscreteHmm, 2> pa;
     for (size_t c = 0; c < 2; ++c) {
       p[c].CheckKeys({"chain", "emission"});
-      pa[c].chain = ChainFrom(p[c]["chain"], atoms);
-      const Eigen::MatrixXd b = p[c]["emission"].FiniteMatrix(atoms, atoms);
-      for (int i = 0; i < atoms; ++i) {
+      pa[c].chain = ChainFrom(p[c]["chain"], d);
+      const Eigen::MatrixXd b = p[c]["emission"].FiniteMatrix(d, d);
+      for (int i = 0; i < d; ++i) {
         if ((b.row(i).array() < 0).any() || std::abs(b.row(i).sum() - 1) > 1e-6) {
           p[c]["emission"][i].Fail("must be probabilities summing to 1");
         }

@@ -83,9 +83,8 @@ struct GestureModels {
   nlohmann::json provenance;
 
   int gesture_count() const { return static_cast<int>(gestures.size()); }
-  int atom_count() const { return static_cast<int>(atoms.size()); }
-  // The Gaussian models' observation size: one value per atom.
-  int dimension() const { return atom_count(); }
+  // The observation's size: one value per atom (weights or pair alike).
+  int dimension() const { return static_cast<int>(atoms.size()); }
 
   // One frame's observation as the Gaussian models read it (dimension()
   // values). Throws std::invalid_argument for weights of another size.

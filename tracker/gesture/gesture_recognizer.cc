@@ -37,19 +37,28 @@ GestureRecognizer::GestureRecognizer(std::shared_ptr<const GestureModels> models
   }
 }
 
-Eigen::VectorXd GestureRecognizer::EmissionOf(const Stream& s, const GestureObservation& o) const {
+bool BothArmsAtRest(std::optional<bool> right, std::optional<bool> left,
+                    const std::optional<GestureObservation>& posture) {
+  if (right && left) return *right && *left;
+  return posture && posture->primary == 0 && posture->secondary == 0;
+}
+
+Eigen::VectorXd GestureRecognizer::EmissionOf(const Stream& s, const GestureObservation& o,
+                                              std::optional<Eigen::VectorXd>& y) const {
   if (s.means.size() == 0) {
     const int symbol = s.primary ? o.primary : o.secondary;
     if (symbol < 0 || symbol >= s.log_emission.cols()) throw std::invalid_argument("an atom outside the models'");
     return s.log_emission.col(symbol);
   }
-  return GaussianLogDensities(models_->ObservationVector(o), s.means, s.covariance).row(0).transpose();
+  if (!y) y = models_->ObservationVector(o);
+  return GaussianLogDensities(*y, s.means, s.covariance).row(0).transpose();
 }
 
 void GestureRecognizer::Advance(const GestureObservation& o) {
   log_likelihoods_.assign(models_->gesture_count(), 0.0);
+  std::optional<Eigen::VectorXd> y;
   for (Stream& s : streams_) {
-    const Eigen::VectorXd e = EmissionOf(s, o);
+    const Eigen::VectorXd e = EmissionOf(s, o, y);
     if (frames_ == 0) {
       s.log_alpha = s.chain.log_initial + e;
     } else {

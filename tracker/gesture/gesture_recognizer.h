@@ -32,6 +32,12 @@ struct GestureDecision {
   int frames = 0;        // observations so far
 };
 
+// Both arms at rest as the recogniser is told (FrameTracker) and as gesture
+// training cuts its segments: by the rest-state classifier where it judged
+// both arms (right, left), else by the recognised pair (A0+A0), else not.
+bool BothArmsAtRest(std::optional<bool> right, std::optional<bool> left,
+                    const std::optional<GestureObservation>& posture);
+
 class GestureRecognizer {
  public:
   GestureRecognizer(std::shared_ptr<const GestureModels> models, GestureModelKind kind,
@@ -58,7 +64,8 @@ class GestureRecognizer {
     bool primary = true;             // discrete: which atom it reads
     Eigen::VectorXd log_alpha{};     // the forward variables so far
   };
-  Eigen::VectorXd EmissionOf(const Stream& s, const GestureObservation& o) const;
+  // `y`: the frame's Gaussian observation, made on the first stream that needs it.
+  Eigen::VectorXd EmissionOf(const Stream& s, const GestureObservation& o, std::optional<Eigen::VectorXd>& y) const;
   void Advance(const GestureObservation& o);
 
   std::shared_ptr<const GestureModels> models_;

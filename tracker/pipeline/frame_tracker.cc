@@ -347,14 +347,12 @@ FrameTracker::Step FrameTracker::Track(int f,
   const auto shape_end = std::chrono::steady_clock::now();
   const double shape_ms = std::chrono::duration<double, std::milli>(shape_end - shape_start).count();
   if (step.shape && posture_atoms_) {
-    const bool at_rest = step.pose && step.pose->tracking && step.pose->rest[0].value_or(false) &&
-                         step.pose->rest[1].value_or(false);
-    user_rest_.Update(step.shape->bins, at_rest);
     // How many arms the rest-state classifier finds at rest, when it judged both.
     std::optional<int> arms_at_rest;
     if (step.pose && step.pose->tracking && step.pose->rest[0] && step.pose->rest[1]) {
       arms_at_rest = int{*step.pose->rest[0]} + int{*step.pose->rest[1]};
     }
+    user_rest_.Update(step.shape->bins, arms_at_rest == 2);
     step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_, arms_at_rest);
   }
   if (gesture_recognizer_) {
@@ -367,9 +365,8 @@ FrameTracker::Step FrameTracker::Track(int f,
     }
     // Both arms at rest by the rest-state classifier; where it has no
     // answer (the pose not tracked), by the recognised posture.
-    const bool classified = step.pose && step.pose->rest[0] && step.pose->rest[1];
-    const bool at_rest = classified ? *step.pose->rest[0] && *step.pose->rest[1]
-                                    : step.posture && step.posture->pair == std::array<int, 2>{0, 0};
+    const bool at_rest = step.pose ? BothArmsAtRest(step.pose->rest[0], step.pose->rest[1], observation)
+                                   : BothArmsAtRest(std::nullopt, std::nullopt, observation);
     step.gesture = gesture_recognizer_->Update(f, observation, at_rest);
   }
   const auto recognition_end = std::chrono::steady_clock::now();
