@@ -979,6 +979,67 @@ TEST(PoseTracker, FlippedPoseKeepsTheArmsWhereTheyWere) {
   }
 }
 
+// The hand's elevation seen from the shoulder, degrees above the horizontal
+// (the bodies here stand upright, so the world's z is the upper body's).
+double HandElevationDeg(const PosedBody& body, bool left) {
+  const Vector3d d = body.joints[left ? kModelLeftHandTip : kModelRightHandTip] -
+                     body.joints[left ? kModelLeftShoulder : kModelRightShoulder];
+  return std::asin(d.z() / d.norm()) * 180 / M_PI;
+}
+
+// Thesis 6.3.2's posture proposal: the arm that is not in the recognised
+// posture is moved into it (its elevation band, or hanging), the arm that is
+// keeps every angle, and the pair goes to the arms the nearer way.
+TEST(PoseTracker, ThePostureProposalMovesTheArmsIntoTheRecognisedPosture) {
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
+  const ArmPostureBand rest{.rest = true}, up{.min_deg = 62.5, .max_deg = 90},
+      diagonal{.min_deg = 22.5, .max_deg = 62.5};
+  const double slack = 12;  // the proposal's jitter, 0.05 per direction component
+  int raised_left = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    // Both arms hanging, one arm recognised up: either arm may take it.
+    const BodyPose standing = StandingPose(shape, Vector2d(0.1, 0.2), yaw(rng));
+    const std::optional<BodyPose> one_up = PostureProposal(standing, shape, {up, rest}, rng);
+    ASSERT_TRUE(one_up);
+    const PosedBody b = PoseBody(shape, *one_up);
+    const bool left = HandElevationDeg(b, true) > HandElevationDeg(b, false);
+    raised_left += left;
+    EXPECT_GT(HandElevationDeg(b, left), 62.5 - slack) << trial;
+    const int kept_shoulder = left ? kDofRightShoulderAzimuth : kDofLeftShoulderAzimuth;
+    const int kept_elbow = left ? kDofRightElbowAzimuth : kDofLeftElbowAzimuth;
+    for (int d : {kept_shoulder, kept_shoulder + 1, kept_elbow, kept_elbow + 1}) {
+      EXPECT_EQ(one_up->dof[d], standing.dof[d]) << trial;
+    }
+
+    // The right arm held out level (not at rest) and the left hanging,
+    // recognised as rest + diagonal: the right arm is nearer the diagonal
+    // and rises into it, keeping its horizontal direction; the left stays.
+    BodyPose level = standing;
+    SetArmDirections(shape, &level, kRightUpperArm,
+                     Vector3d(std::cos(level.dof[kDofYaw]), std::sin(level.dof[kDofYaw]), 0),
+                     Vector3d(std::cos(level.dof[kDofYaw]), std::sin(level.dof[kDofYaw]), 0));
+    const std::optional<BodyPose> raised = PostureProposal(level, shape, {rest, diagonal}, rng);
+    ASSERT_TRUE(raised);
+    const PosedBody r = PoseBody(shape, *raised), l = PoseBody(shape, level);
+    EXPECT_GT(HandElevationDeg(r, false), 22.5 - slack) << trial;
+    EXPECT_LT(HandElevationDeg(r, false), 62.5 + slack) << trial;
+    const Vector3d before = l.joints[kModelRightHandTip] - l.joints[kModelRightShoulder];
+    const Vector3d after = r.joints[kModelRightHandTip] - r.joints[kModelRightShoulder];
+    const double turned = std::acos(std::clamp(before.head<2>().normalized().dot(after.head<2>().normalized()), -1.0, 1.0));
+    EXPECT_LT(turned * 180 / M_PI, 15) << trial;
+    for (int d : {kDofLeftShoulderAzimuth, kDofLeftShoulderZenith, kDofLeftElbowAzimuth, kDofLeftElbowZenith}) {
+      EXPECT_EQ(raised->dof[d], level.dof[d]) << trial;
+    }
+    // A pose already in the posture is left to the other proposals.
+    EXPECT_FALSE(PostureProposal(standing, shape, {rest, rest}, rng)) << trial;
+  }
+  // Both hanging arms are equally near: the pair goes either way.
+  EXPECT_GT(raised_left, 5);
+  EXPECT_LT(raised_left, 35);
+}
+
 }  // namespace
 }  // namespace irbench
 

@@ -219,6 +219,38 @@ nlohmann::json PostureJson(const std::optional<Posture>& posture, const PostureA
   return {{"pair", {atoms->names[posture->pair[0]], atoms->names[posture->pair[1]]}}, {"weights", weights}};
 }
 
+// The pair the posture's weights alone give, as arm postures for the pose
+// tracker's posture proposal (thesis 6.3.2). Not the pair that agrees with
+// the pose tracker's rest state (PostureAtoms::pair_rest_state): the
+// proposal is to bring the shape's own evidence to the filter. The atoms
+// are named by the sim's posture labels (docs/truth.md): A0 at rest, else
+// by the elevation e of the hand tip seen from the shoulder, A2 e >= 62.5
+// deg, A3 >= 22.5, A1 >= -22.5, A4 below (down to a hanging arm, about
+// -60). None when an atom has another name.
+std::optional<PostureBands> PostureBandsOf(const Posture& posture, const PostureAtoms& atoms) {
+  const std::vector<double> arm_weights(posture.weights.begin() + 1, posture.weights.end());
+  const std::array<int, 2> pair =
+      posture.weights[0] > 0 ? PairFromWeights(arm_weights, atoms) : std::array<int, 2>{0, 0};
+  PostureBands bands;
+  for (int i = 0; i < 2; ++i) {
+    const std::string& name = atoms.names[pair[i]];
+    if (name == "A0") {
+      bands[i] = {.rest = true};
+    } else if (name == "A1") {
+      bands[i] = {.min_deg = -22.5, .max_deg = 22.5};
+    } else if (name == "A2") {
+      bands[i] = {.min_deg = 62.5, .max_deg = 90};
+    } else if (name == "A3") {
+      bands[i] = {.min_deg = 22.5, .max_deg = 62.5};
+    } else if (name == "A4") {
+      bands[i] = {.min_deg = -60, .max_deg = -22.5};
+    } else {
+      return std::nullopt;
+    }
+  }
+  return bands;
+}
+
 }  // namespace
 
 std::shared_ptr<const RestClassifier> LoadRestClassifier(const TrackerSettings& settings) {
@@ -354,6 +386,12 @@ FrameTracker::Step FrameTracker::Track(int f,
     }
     user_rest_.Update(step.shape->bins, arms_at_rest == 2);
     step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_, arms_at_rest);
+  }
+  // The posture proposal of the next frame-set's particles.
+  if (pose_tracker_) {
+    pose_tracker_->set_posture(step.posture && step.pose && step.pose->tracking
+                                   ? PostureBandsOf(*step.posture, *posture_atoms_)
+                                   : std::nullopt);
   }
   if (gesture_recognizer_) {
     std::optional<GestureObservation> observation;

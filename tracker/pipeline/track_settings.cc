@@ -57,6 +57,11 @@ std::vector<TrackSetting> MakeSettings() {
       {"refine_fraction", "--refine-fraction",
        "pose: share of the particles refined by 2D-3D ICP each frame (thesis 6.3.3)",
        DoubleBinding{[](TrackerSettings& t) -> double& { return t.pose.refine_fraction; }, 0, 1}});
+  s.push_back(
+      {"posture_proposal", "--posture-proposal",
+       "pose: weight of the posture proposal (thesis 6.3.2: the arms moved into the posture recognised\n"
+       "the frame-set before) beside the others' 1.0; 0: off (the default, docs/recognition.md)",
+       DoubleBinding{[](TrackerSettings& t) -> double& { return t.pose.p_posture; }, 0, 1}});
   s.push_back({"seed", "--seed", "pose: seed of the filter's random stream",
                Uint64Binding{[](TrackerSettings& t) -> uint64_t& { return t.pose.seed; }}});
   s.push_back(

@@ -82,6 +82,66 @@ BodyPose ArmDirectionProposal(BodyPose pose, const ProposalContext& context, std
   return pose;
 }
 
+std::optional<BodyPose> PostureProposal(const BodyPose& current,
+                                        const BodyShape& shape,
+                                        const PostureBands& posture,
+                                        std::mt19937_64& rng) {
+  const PosedBody body = PoseBody(shape, current);
+  const Eigen::Matrix3d world_from_upper = body.frames[kUpperBody].linear();
+  const struct {
+    int segment, shoulder, tip;
+    double side;  // the arm's side along the upper body's x
+  } arms[] = {{kRightUpperArm, kModelRightShoulder, kModelRightHandTip, 1.0},
+              {kLeftUpperArm, kModelLeftShoulder, kModelLeftHandTip, -1.0}};
+  // Each arm's hand direction in the upper body's frame (x right, y forward, z up).
+  std::array<Vector3d, 2> hand;
+  for (int a = 0; a < 2; ++a) {
+    hand[a] = (world_from_upper.transpose() * (body.joints[arms[a].tip] - body.joints[arms[a].shoulder]))
+                  .normalized();
+  }
+  auto band_of = [](const ArmPostureBand& b) {
+    // A hanging arm's hand lies below -60 deg.
+    return b.rest ? std::pair{-90.0, -60.0} : std::pair{b.min_deg, b.max_deg};
+  };
+  auto miss = [&](const Vector3d& d, const ArmPostureBand& b) {
+    const double e = std::asin(std::clamp(d.z(), -1.0, 1.0)) * 180 / M_PI;
+    const auto [lo, hi] = band_of(b);
+    return std::max(0.0, std::max(lo - e, e - hi));
+  };
+  const double kept = miss(hand[0], posture[0]) + miss(hand[1], posture[1]);
+  const double swapped = miss(hand[0], posture[1]) + miss(hand[1], posture[0]);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const bool swap = swapped < kept || (swapped == kept && unit(rng) < 0.5);
+  BodyPose next = current;
+  bool changed = false;
+  std::normal_distribution<double> jitter(0.0, 0.05);
+  for (int a = 0; a < 2; ++a) {
+    const ArmPostureBand& b = posture[swap ? 1 - a : a];
+    if (miss(hand[a], b) == 0) continue;
+    changed = true;
+    Vector3d dir;
+    if (b.rest) {
+      dir = Vector3d(0.15 * arms[a].side, 0.0, -1.0).normalized();
+    } else {
+      const auto [lo, hi] = band_of(b);
+      const double e = (lo + (hi - lo) * unit(rng)) * M_PI / 180;
+      Vector2d h = hand[a].head<2>();
+      if (h.norm() < 0.2) {
+        const double t = 0.5 * M_PI * unit(rng);  // sideways (0) to forward
+        h = Vector2d(arms[a].side * std::cos(t), std::sin(t));
+      }
+      h.normalize();
+      dir = Vector3d(std::cos(e) * h.x(), std::cos(e) * h.y(), std::sin(e));
+    }
+    const Vector3d world = world_from_upper * dir;
+    const Vector3d noise_u(jitter(rng), jitter(rng), jitter(rng));
+    const Vector3d noise_f(jitter(rng), jitter(rng), jitter(rng));
+    SetArmDirections(shape, &next, arms[a].segment, (world + noise_u).normalized(), (world + noise_f).normalized());
+  }
+  if (!changed) return std::nullopt;
+  return next;
+}
+
 BodyPose DefaultPoseProposal(const BodyPose& current,
                              const ProposalContext& context,
                              std::mt19937_64& rng) {
@@ -221,7 +281,7 @@ BodyPose ProposeParticle(const BodyPose& current,
                          std::mt19937_64& rng) {
   const PoseTrackerOptions& options = context.options;
   const double total = options.p_random_walk + options.p_body_position + options.p_arm_direction +
-                       options.p_default_pose;
+                       options.p_default_pose + options.p_posture;
   std::uniform_real_distribution<double> u(0.0, total);
   const double choice = u(rng);
   std::normal_distribution<double> n01(0.0, 1.0);
@@ -252,8 +312,15 @@ BodyPose ProposeParticle(const BodyPose& current,
     next = BodyPositionProposal(current, context, n01, rng);
   } else if (choice < options.p_random_walk + options.p_body_position + options.p_arm_direction) {
     next = ArmDirectionProposal(current, context, rng);
-  } else {
+  } else if (choice < options.p_random_walk + options.p_body_position + options.p_arm_direction +
+                          options.p_default_pose) {
     next = DefaultPoseProposal(current, context, rng);
+  } else {
+    // The posture proposal; the random walk where there is no posture or
+    // the particle already holds it.
+    std::optional<BodyPose> moved;
+    if (context.posture) moved = PostureProposal(current, context.shape, *context.posture, rng);
+    next = moved ? *moved : RandomWalkProposal(current, previous, k, options, n01, rng);
   }
   // While the user walks, a particle facing more than 90 deg away from the
   // walking direction is turned to it (people do not walk backwards onto a

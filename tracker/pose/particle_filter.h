@@ -15,7 +15,9 @@
 // random draw comes from the tracker's one generator, passed by reference.
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -26,6 +28,17 @@
 #include "tracker/pose/pose_tracker_options.h"
 
 namespace irbench {
+
+// One arm's posture as the posture recogniser (thesis 5.1) names it: at rest,
+// or the hand tip seen from the shoulder at an elevation in
+// [min_deg, max_deg] above the upper body's horizontal plane.
+struct ArmPostureBand {
+  bool rest = false;
+  double min_deg = 0, max_deg = 0;
+};
+// A recognised two-arm posture: its two atoms' bands, which arm holds which
+// unknown (the recogniser sees the shape, not the sides).
+using PostureBands = std::array<ArmPostureBand, 2>;
 
 // What the proposals (thesis 6.3.2) read of this frame and of the tracker's
 // state; the references must outlive the proposals.
@@ -43,6 +56,9 @@ struct ProposalContext {
   bool walking = false;   // the user walks: the heading is the walk's
   bool entering = false;  // first seen half in view, not yet seen walking
   bool lost = false;      // last frame's best particle explained the silhouettes poorly
+  // The posture recognised in the frame-set before (PoseTracker::set_posture);
+  // none: the posture proposal falls back to the random walk.
+  std::optional<PostureBands> posture;
 };
 
 // A particle's log-likelihood: the observation (thesis 6.3.1) plus the
@@ -82,6 +98,18 @@ BodyPose BodyPositionProposal(const BodyPose& current,
 // (at random) pointed along the points the arm's shoulder owns; an arm they
 // do not show hangs down half the time.
 BodyPose ArmDirectionProposal(BodyPose pose, const ProposalContext& context, std::mt19937_64& rng);
+
+// Thesis 6.3.2, "Shape Descriptor & Posture Recognition Function": the arms
+// of `current` moved into the recognised posture. The pair's two bands are
+// given to the arms the cheaper way (each arm's hand elevation nearest its
+// band; ties at random); an arm outside its band gets an elevation drawn
+// uniformly in it, keeping its horizontal direction (sideways to forward at
+// random where it points straight up or down), straight, or hangs when the
+// band is rest. None when both arms already lie in their bands.
+std::optional<BodyPose> PostureProposal(const BodyPose& current,
+                                        const BodyShape& shape,
+                                        const PostureBands& posture,
+                                        std::mt19937_64& rng);
 
 // Thesis 6.3.2, default poses at the hull's root with `current`'s heading:
 // standing, scarecrow, or pointing forward with one arm.

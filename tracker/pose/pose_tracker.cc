@@ -311,16 +311,10 @@ std::vector<BodyPose> PoseTracker::ProposeParticles(const FrameFeatures& feature
                                   .walk_dir = walk_dir_,
                                   .walking = walking_,
                                   .entering = entering_,
-                                  .lost = lost_};
+                                  .lost = lost_,
+                                  .posture = posture_};
     for (size_t i = 0; i < particles_.size(); ++i) {
       proposed.push_back(ProposeParticle(particles_[i], previous_[i], dt, context, rng_));
-    }
-  }
-  if (hook_) {
-    // Posture-recognition proposals replace the last particles.
-    std::vector<BodyPose> extra = hook_(features, shape_);
-    for (size_t i = 0; i < extra.size() && i < proposed.size(); ++i) {
-      proposed[proposed.size() - 1 - i] = extra[i];
     }
   }
   return proposed;

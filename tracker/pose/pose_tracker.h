@@ -3,7 +3,7 @@
 // body whose observation is the silhouette overlap of every camera
 // (observation.h), with the thesis's proposal functions — a random walk with
 // velocity, the body position from the voxel hull, arm directions from the 3D
-// arm axis points, default poses, and a hook for posture recognition — a
+// arm axis points, default poses, and the recognised posture (set_posture) — a
 // 2D-3D ICP refinement of a random subset (icp.h), joint limits and
 // resampling (particle_filter.h). The model is sized to the user as they
 // enter (body_calibration.h, thesis 6.1.2). The best particle gives the
@@ -15,7 +15,6 @@
 #include <Eigen/Core>
 #include <array>
 #include <deque>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <random>
@@ -55,10 +54,6 @@ struct PoseEstimate {
   double ms_observation = 0, ms_refine = 0, ms_total = 0;
 };
 
-// Extra proposals, e.g. from posture recognition (thesis 6.3.2, "Shape
-// Descriptor & Posture Recognition Function"): poses to seed particles with.
-using PoseProposalHook = std::function<std::vector<BodyPose>(const FrameFeatures&, const BodyShape&)>;
-
 // Does `camera` hold a box of half-width `margin_m` about `root` (x, y),
 // from the floor to `height_m`, inside its image (its corners in front of it
 // and on its pixels)? The pose tracker's "in view" test.
@@ -74,7 +69,10 @@ class PoseTracker {
   // One frame-set: `dt` seconds after the previous one.
   PoseEstimate Step(const FrameFeatures& features, double dt);
 
-  void set_proposal_hook(PoseProposalHook hook) { hook_ = std::move(hook); }
+  // The posture the posture recogniser (thesis 5.1) found in this frame-set,
+  // for the next Step's posture proposal (PoseTrackerOptions::p_posture);
+  // none: no posture recognised.
+  void set_posture(std::optional<PostureBands> posture) { posture_ = posture; }
   // The rest-state classifier (thesis 6.4); an arm it finds at rest is
   // forced down in the estimate.
   void set_rest_classifier(std::shared_ptr<const RestClassifier> rest) { rest_ = std::move(rest); }
@@ -98,7 +96,7 @@ class PoseTracker {
   // particles seeded at its root.
   void Initialise(const FrameFeatures& features);
   // Thesis 6.3.2: this frame's proposed particles (the first frame's seeds
-  // on acquiring a user), the hook's proposals replacing the last ones.
+  // on acquiring a user).
   std::vector<BodyPose> ProposeParticles(const FrameFeatures& features, double dt);
   // The best particle as the estimate: pose, overlaps, in view, tracking.
   // Returns whether it explains the silhouettes (min_overlap).
@@ -144,7 +142,7 @@ class PoseTracker {
   std::vector<ScreenSurface> screens_;
   PoseTrackerOptions options_;
   std::mt19937_64 rng_;
-  PoseProposalHook hook_;
+  std::optional<PostureBands> posture_;
   std::shared_ptr<const RestClassifier> rest_;
   Eigen::Vector2d facing_xy_ = Eigen::Vector2d::UnitY();
   // The feet's direction (HullLegs::toes), averaged over feet_memory_s; zero

@@ -23,6 +23,10 @@ struct PoseTrackerOptions {
   double p_body_position = 0.10;
   double p_arm_direction = 0.12;
   double p_default_pose = 0.08;
+  // The posture proposal (PostureProposal): the arms moved into the posture
+  // the posture recogniser found in the frame-set before. Off by default:
+  // measured on the full suite, docs/recognition.md.
+  double p_posture = 0.0;
   // Share of particles turned half way round with their arms swapped
   // (FlippedPose), tried before the proposals above.
   double p_flip = 0.03;
