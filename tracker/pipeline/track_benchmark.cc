@@ -8,6 +8,7 @@
 
 #include "common/logging.h"
 #include "tracker/frontend/frontend.h"
+#include "tracker/pipeline/frame_tracker.h"
 #include "tracker/pose/pose_tracker.h"
 
 namespace irbench {
@@ -146,6 +147,38 @@ std::vector<TrackBenchRow> PoseRows(const SequenceInput& input,
   return rows;
 }
 
+// The recognition rows (thesis 4.3, 5.1, 5.2) as irbench track runs them
+// with its defaults (the shipped posture atoms and gesture models): the
+// shape descriptor, then the posture decomposition with the gesture
+// models' update, per frame-set with a descriptor; none without atoms.
+std::vector<TrackBenchRow> RecognitionRows(const SequenceInput& input,
+                                           const std::vector<std::vector<cv::Mat>>& images,
+                                           int repeats) {
+  const TrackerSettings settings;
+  std::vector<double> shape_ms, recognition_ms, both_ms;
+  for (int r = 0; r < repeats; ++r) {
+    FrameTracker tracker(input, settings, EffectiveFrontEndOptions(settings), LoadRestClassifierIfPresent());
+    if (tracker.posture_atoms_path().empty()) {
+      Log().warn("bench track: no posture atoms; the recognition rows are left out");
+      return {};
+    }
+    for (size_t f = 0; f < images.size(); ++f) {
+      const FrameTracker::Step step =
+          tracker.Track(static_cast<int>(f), images[f], std::vector<std::string>(images[f].size()), 1.0 / input.fps());
+      if (!step.shape) continue;
+      const double shape = step.features_line["ms"]["shape"].get<double>();
+      const double recognition = step.features_line["ms"]["postures_gestures"].get<double>();
+      shape_ms.push_back(shape);
+      recognition_ms.push_back(recognition);
+      both_ms.push_back(shape + recognition);
+    }
+  }
+  if (both_ms.empty()) return {};
+  return {SummaryRow("shape descriptor of the voxel hull (4.3)", std::move(shape_ms)),
+          SummaryRow("postures and the gesture models' update (5.1, 5.2)", std::move(recognition_ms)),
+          SummaryRow("descriptor + postures + gestures", std::move(both_ms))};
+}
+
 }  // namespace
 
 std::vector<TrackBenchRow> RunTrackBenchmark(const fs::path& sequence, int repeats, int* cameras) {
@@ -161,6 +194,7 @@ std::vector<TrackBenchRow> RunTrackBenchmark(const fs::path& sequence, int repea
   samples.one_thread = TimeFrontEndOneThread(front_end, images, repeats);
   std::vector<TrackBenchRow> rows = FrontEndRows(samples);
   for (TrackBenchRow& row : PoseRows(input, all_features, repeats)) rows.push_back(std::move(row));
+  for (TrackBenchRow& row : RecognitionRows(input, images, repeats)) rows.push_back(std::move(row));
   return rows;
 }
 

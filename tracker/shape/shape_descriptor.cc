@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <mutex>
 #include <numbers>
+#include <opencv2/core/utility.hpp>
 #include <stdexcept>
 
 #include "common/error.h"
@@ -122,9 +124,14 @@ ShapeDescriptor ComputeShapeDescriptor(const std::vector<Eigen::Vector3d>& point
   std::vector<float> cos_edge(kt + 1);
   for (int l = 0; l <= kt; ++l) cos_edge[l] = static_cast<float>(std::cos(l * std::numbers::pi / kt));
   const float phi_scale = static_cast<float>(kp / (2 * std::numbers::pi));
-  for (int ring = 0; ring < options.rings; ++ring) {
-    const float z_ring = static_cast<float>((ring + 0.5) * height_m / options.rings);
-    for (int a = 0; a < options.azimuths; ++a) {
+  // The reference points in parallel, each range counting into its own
+  // histogram; integer counts sum to the same bytes however it is split.
+  std::mutex merge;
+  cv::parallel_for_(cv::Range(0, options.rings * options.azimuths), [&](const cv::Range& range) {
+    std::vector<uint32_t> local(counts.size(), 0);
+    for (int reference = range.start; reference < range.end; ++reference) {
+      const int ring = reference / options.azimuths, a = reference % options.azimuths;
+      const float z_ring = static_cast<float>((ring + 0.5) * height_m / options.rings);
       const double alpha = 2 * std::numbers::pi * a / options.azimuths;
       const Eigen::Vector2f normal(static_cast<float>(std::cos(alpha)), static_cast<float>(std::sin(alpha)));
       const Eigen::Vector2f tangent(-normal.y(), normal.x());
@@ -143,10 +150,12 @@ ShapeDescriptor ComputeShapeDescriptor(const std::vector<Eigen::Vector3d>& point
         // Bins centred on phi = j 2 pi / P: inward (phi = +-pi) is one bin.
         int pb = static_cast<int>(std::floor(std::atan2(dt, dn) * phi_scale + 0.5f));
         pb = ((pb % kp) + kp) % kp;
-        ++counts[(static_cast<size_t>(k) * kt + l) * kp + pb];
+        ++local[(static_cast<size_t>(k) * kt + l) * kp + pb];
       }
     }
-  }
+    const std::lock_guard<std::mutex> lock(merge);
+    for (size_t i = 0; i < counts.size(); ++i) counts[i] += local[i];
+  }, std::max(1, cv::getNumThreads()));  // one histogram per thread, not per reference point
   std::vector<double> h(counts.begin(), counts.end());
   if (options.smoothing_bins > 0) {
     std::vector<double> kernel;
