@@ -312,8 +312,8 @@ BodyPose ProposeParticle(const BodyPose& current,
     next = BodyPositionProposal(current, context, n01, rng);
   } else if (choice < options.p_random_walk + options.p_body_position + options.p_arm_direction) {
     next = ArmDirectionProposal(current, context, rng);
-  } else if (choice < options.p_random_walk + options.p_body_position + options.p_arm_direction +
-                          options.p_default_pose) {
+  } else if (options.p_posture <= 0 || choice < options.p_random_walk + options.p_body_position +
+                                                   options.p_arm_direction + options.p_default_pose) {
     next = DefaultPoseProposal(current, context, rng);
   } else {
     // The posture proposal; the random walk where there is no posture or
