@@ -1,5 +1,7 @@
 #include "sim/motion/labels.h"
 
+#include "sequence_format/posture_labels.h"
+
 #include <cmath>
 
 namespace irbench {
@@ -40,12 +42,12 @@ std::string MotionLabel(bool rest, const Eigen::Vector3d& v) {
 }
 
 std::string ArmAtom(bool rest, const Eigen::Vector3d& shoulder_to_tip) {
-  if (rest) return "A0";
+  if (rest) return std::string(kRestAtom);
   const double el = std::asin(std::clamp(shoulder_to_tip.normalized().z(), -1.0, 1.0)) / kRadiansPerDegree;
-  if (el >= 62.5) return "A2";
-  if (el >= 22.5) return "A3";
-  if (el >= -22.5) return "A1";
-  return "A4";
+  for (const ArmAtomBand& band : kArmAtomBands) {
+    if (el >= band.min_deg) return std::string(band.name);
+  }
+  return std::string(kArmAtomBands.back().name);
 }
 
 Labeler::Labeler(const Avatar& avatar, const Scene* scene, const MotionSource& motion)

@@ -1,10 +1,12 @@
 #include "tracker/pipeline/frame_tracker.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
 
 #include "common/logging.h"
+#include "sequence_format/posture_labels.h"
 #include "tracker/body_model/body_model.h"
 
 namespace irbench {
@@ -223,10 +225,9 @@ nlohmann::json PostureJson(const std::optional<Posture>& posture, const PostureA
 // tracker's posture proposal (thesis 6.3.2). Not the pair that agrees with
 // the pose tracker's rest state (PostureAtoms::pair_rest_state): the
 // proposal is to bring the shape's own evidence to the filter. The atoms
-// are named by the sim's posture labels (docs/truth.md): A0 at rest, else
-// by the elevation e of the hand tip seen from the shoulder, A2 e >= 62.5
-// deg, A3 >= 22.5, A1 >= -22.5, A4 below (down to a hanging arm, about
-// -60). None when an atom has another name.
+// are named by the truth's posture labels (sequence_format/posture_labels.h);
+// the lowest band ends at a hanging arm, about -60 deg. None when an atom
+// has another name.
 std::optional<PostureBands> PostureBandsOf(const Posture& posture, const PostureAtoms& atoms) {
   const std::vector<double> arm_weights(posture.weights.begin() + 1, posture.weights.end());
   const std::array<int, 2> pair =
@@ -234,19 +235,14 @@ std::optional<PostureBands> PostureBandsOf(const Posture& posture, const Posture
   PostureBands bands;
   for (int i = 0; i < 2; ++i) {
     const std::string& name = atoms.names[pair[i]];
-    if (name == "A0") {
+    if (name == kRestAtom) {
       bands[i] = {.rest = true};
-    } else if (name == "A1") {
-      bands[i] = {.min_deg = -22.5, .max_deg = 22.5};
-    } else if (name == "A2") {
-      bands[i] = {.min_deg = 62.5, .max_deg = 90};
-    } else if (name == "A3") {
-      bands[i] = {.min_deg = 22.5, .max_deg = 62.5};
-    } else if (name == "A4") {
-      bands[i] = {.min_deg = -60, .max_deg = -22.5};
-    } else {
-      return std::nullopt;
+      continue;
     }
+    const auto band = std::find_if(kArmAtomBands.begin(), kArmAtomBands.end(),
+                                   [&](const ArmAtomBand& b) { return b.name == name; });
+    if (band == kArmAtomBands.end()) return std::nullopt;
+    bands[i] = {.min_deg = std::max(band->min_deg, -60.0), .max_deg = band->max_deg};
   }
   return bands;
 }
@@ -287,6 +283,7 @@ FrameTracker::FrameTracker(const SequenceInput& input,
       left_out_counts_(input.cameras().size()) {
   if (settings.stage == TrackStage::kPose) {
     pose_tracker_.emplace(input.cameras(), input.screens(), settings.pose);
+    posture_proposal_ = settings.pose.p_posture > 0;
     if (rest_classifier) pose_tracker_->set_rest_classifier(rest_classifier);
     rest_classifier_ = std::move(rest_classifier);
     LoadMotionLabeler(settings);
@@ -387,8 +384,8 @@ FrameTracker::Step FrameTracker::Track(int f,
     user_rest_.Update(step.shape->bins, arms_at_rest == 2);
     step.posture = DecomposePosture(step.shape->bins, user_rest_.Current(), *posture_atoms_, arms_at_rest);
   }
-  // The posture proposal of the next frame-set's particles.
-  if (pose_tracker_) {
+  // The posture proposal of the next frame-set's particles, when it is on.
+  if (pose_tracker_ && posture_proposal_) {
     pose_tracker_->set_posture(step.posture && step.pose && step.pose->tracking
                                    ? PostureBandsOf(*step.posture, *posture_atoms_)
                                    : std::nullopt);

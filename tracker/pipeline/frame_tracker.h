@@ -91,6 +91,7 @@ class FrameTracker {
   double train_ms_ = 0;
   FrontEnd front_end_;
   std::optional<PoseTracker> pose_tracker_;
+  bool posture_proposal_ = false;  // the pose tracker proposes from the recognised posture (p_posture > 0)
   ShapeDescriptorOptions shape_options_;  // the atoms' when there are atoms
   std::filesystem::path posture_atoms_path_;
   std::shared_ptr<const PostureAtoms> posture_atoms_;

@@ -155,9 +155,10 @@ std::vector<TrackBenchRow> RecognitionRows(const SequenceInput& input,
                                            const std::vector<std::vector<cv::Mat>>& images,
                                            int repeats) {
   const TrackerSettings settings;
+  const std::shared_ptr<const RestClassifier> rest = LoadRestClassifierIfPresent();
   std::vector<double> shape_ms, recognition_ms, both_ms;
   for (int r = 0; r < repeats; ++r) {
-    FrameTracker tracker(input, settings, EffectiveFrontEndOptions(settings), LoadRestClassifierIfPresent());
+    FrameTracker tracker(input, settings, EffectiveFrontEndOptions(settings), rest);
     if (tracker.posture_atoms_path().empty()) {
       Log().warn("bench track: no posture atoms; the recognition rows are left out");
       return {};
