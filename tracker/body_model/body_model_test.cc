@@ -138,6 +138,82 @@ TEST(BodyModel, JointLimitsKeepAllowedPosesAndCapTheRest) {
   EXPECT_TRUE(ClampToJointLimits(&pose));  // now inside
 }
 
+// The forearm's component along the elbow's forward axis: the body's forward
+// (y) carried by the minimal rotation that takes straight down to the upper
+// arm, computed here from the posed joints.
+double ForearmForward(const PosedBody& body, int shoulder_joint) {
+  const Eigen::Matrix3d upper = body.frames[kUpperBody].linear();
+  const Vector3d u = upper.transpose() * (body.joints[shoulder_joint + 1] - body.joints[shoulder_joint]).normalized();
+  const Vector3d f = upper.transpose() * (body.joints[shoulder_joint + 2] - body.joints[shoulder_joint + 1]).normalized();
+  const Vector3d forward = Eigen::Quaterniond::FromTwoVectors(Vector3d(0, 0, -1), u) * Vector3d::UnitY();
+  return f.dot(forward);
+}
+
+TEST(BodyModel, TheElbowDoesNotBendBackwards) {
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  // A hanging right arm, the forearm bent 60 deg straight back: turned to
+  // the edge where it points 0.2 of its length backwards, its bend kept.
+  BodyPose pose = StandingPose(shape, Vector2d::Zero(), 0.4);
+  pose.dof[kDofRightShoulderZenith] = 0.0;
+  pose.dof[kDofRightElbowAzimuth] = -M_PI / 2 + 0.1;
+  pose.dof[kDofRightElbowZenith] = M_PI / 3;
+  EXPECT_FALSE(ClampToJointLimits(&pose));
+  EXPECT_NEAR(ForearmForward(PoseBody(shape, pose), kModelRightShoulder), -0.2, 1e-9);
+  EXPECT_NEAR(pose.dof[kDofRightElbowZenith], M_PI / 3, 1e-12);
+  // The nearer edge: bent back and out goes out, back and in goes in.
+  EXPECT_NEAR(pose.dof[kDofRightElbowAzimuth], -std::asin(0.2 / std::sin(M_PI / 3)), 1e-12);
+  pose.dof[kDofRightElbowAzimuth] = -M_PI / 2 - 0.1;
+  EXPECT_FALSE(ClampToJointLimits(&pose));
+  EXPECT_NEAR(pose.dof[kDofRightElbowAzimuth], -M_PI + std::asin(0.2 / std::sin(M_PI / 3)), 1e-12);
+  // Bent forward, or barely bent whichever way: allowed.
+  pose.dof[kDofRightElbowAzimuth] = M_PI / 2;
+  EXPECT_TRUE(ClampToJointLimits(&pose));
+  pose.dof[kDofRightElbowAzimuth] = -M_PI / 2;
+  pose.dof[kDofRightElbowZenith] = 0.19;
+  EXPECT_TRUE(ClampToJointLimits(&pose));
+
+  // Brute force over arms anywhere, twisted or not, both sides: after the
+  // caps no forearm points more than 0.2 backwards, and a pose inside keeps
+  // every angle.
+  std::mt19937 rng(11);
+  // Drawn inside the other caps (the upper arm's cone, the elbow's 150 deg).
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), zenith(0.0, 2.6), twist(-0.6, 0.6);
+  const Vector3d cone_centre = Vector3d(0.86, 0.51, 0).normalized();
+  int capped = 0;
+  for (int i = 0; i < 4000; ++i) {
+    BodyPose p = StandingPose(shape, Vector2d::Zero(), angle(rng));
+    for (int dof : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
+      do {
+        p.dof[dof] = angle(rng);
+        p.dof[dof + 1] = std::acos(std::uniform_real_distribution<double>(-0.99, 1.0)(rng));
+      } while (DirectionFromAngles(p.dof[dof], p.dof[dof + 1], -1, false).dot(cone_centre) <
+               std::cos(120.0 * M_PI / 180.0));
+      p.dof[dof + 2] = twist(rng);
+    }
+    for (int dof : {kDofRightElbowAzimuth, kDofLeftElbowAzimuth}) {
+      p.dof[dof] = angle(rng);
+      p.dof[dof + 1] = zenith(rng);
+    }
+    const double right = ForearmForward(PoseBody(shape, p), kModelRightShoulder);
+    const double left = ForearmForward(PoseBody(shape, p), kModelLeftShoulder);
+    const BodyPose before = p;
+    const bool inside = ClampToJointLimits(&p);
+    const PosedBody body = PoseBody(shape, p);
+    EXPECT_GE(ForearmForward(body, kModelRightShoulder), -0.2 - 1e-9);
+    EXPECT_GE(ForearmForward(body, kModelLeftShoulder), -0.2 - 1e-9);
+    EXPECT_EQ(inside, right >= -0.2 - 1e-12 && left >= -0.2 - 1e-12) << i;
+    if (!inside) ++capped;
+    for (int d = 0; d < kDofCount; ++d) {
+      if (d == kDofRightElbowAzimuth || d == kDofLeftElbowAzimuth) continue;
+      EXPECT_NEAR(p.dof[d], before.dof[d], 1e-12) << BodyDofName(d);
+    }
+    if (inside) {
+      EXPECT_NEAR(p.dof[kDofRightElbowAzimuth], before.dof[kDofRightElbowAzimuth], 1e-12);
+    }
+  }
+  EXPECT_GT(capped, 500);  // the draw does reach the forbidden range
+}
+
 }  // namespace
 }  // namespace irbench
 
