@@ -18,10 +18,10 @@ constexpr double kElbowMaxZenith = 150.0 * M_PI / 180.0;
 // raises it (the elbow's frame), a bent forearm points forward, inwards or
 // out, never back: its component along the frame's y (forward for a
 // hanging arm) stays above -kElbowMaxBackward. The truth of the 48 CMU
-// scenarios of the full suite (18,000 arm-frames, the real elbows of eight
-// avatars) lies below -0.2 in 0.4 % of arm-frames; the tracked arms did in
-// 9.5 % before this cap (docs/tracker.md).
-constexpr double kElbowMaxBackward = 0.2;
+// scenarios of the full suite (24,500 arm-frames, the real elbows of eight
+// avatars) lies below -0.1 in 0.7 % of arm-frames; the tracked arms did in
+// about 11 % before this cap (docs/tracker.md).
+constexpr double kElbowMaxBackward = 0.1;
 constexpr double kNeckMaxZenith = 40.0 * M_PI / 180.0;
 // Zenith 180 deg (an arm straight up) has no unique swing; stay just short.
 constexpr double kMaxZenith = 178.0 * M_PI / 180.0;

@@ -152,28 +152,28 @@ double ForearmForward(const PosedBody& body, int shoulder_joint) {
 TEST(BodyModel, TheElbowDoesNotBendBackwards) {
   const BodyShape shape = BodyShape::FromHeight(1.75);
   // A hanging right arm, the forearm bent 60 deg straight back: turned to
-  // the edge where it points 0.2 of its length backwards, its bend kept.
+  // the edge where it points 0.1 of its length backwards, its bend kept.
   BodyPose pose = StandingPose(shape, Vector2d::Zero(), 0.4);
   pose.dof[kDofRightShoulderZenith] = 0.0;
   pose.dof[kDofRightElbowAzimuth] = -M_PI / 2 + 0.1;
   pose.dof[kDofRightElbowZenith] = M_PI / 3;
   EXPECT_FALSE(ClampToJointLimits(&pose));
-  EXPECT_NEAR(ForearmForward(PoseBody(shape, pose), kModelRightShoulder), -0.2, 1e-9);
+  EXPECT_NEAR(ForearmForward(PoseBody(shape, pose), kModelRightShoulder), -0.1, 1e-9);
   EXPECT_NEAR(pose.dof[kDofRightElbowZenith], M_PI / 3, 1e-12);
   // The nearer edge: bent back and out goes out, back and in goes in.
-  EXPECT_NEAR(pose.dof[kDofRightElbowAzimuth], -std::asin(0.2 / std::sin(M_PI / 3)), 1e-12);
+  EXPECT_NEAR(pose.dof[kDofRightElbowAzimuth], -std::asin(0.1 / std::sin(M_PI / 3)), 1e-12);
   pose.dof[kDofRightElbowAzimuth] = -M_PI / 2 - 0.1;
   EXPECT_FALSE(ClampToJointLimits(&pose));
-  EXPECT_NEAR(pose.dof[kDofRightElbowAzimuth], -M_PI + std::asin(0.2 / std::sin(M_PI / 3)), 1e-12);
+  EXPECT_NEAR(pose.dof[kDofRightElbowAzimuth], -M_PI + std::asin(0.1 / std::sin(M_PI / 3)), 1e-12);
   // Bent forward, or barely bent whichever way: allowed.
   pose.dof[kDofRightElbowAzimuth] = M_PI / 2;
   EXPECT_TRUE(ClampToJointLimits(&pose));
   pose.dof[kDofRightElbowAzimuth] = -M_PI / 2;
-  pose.dof[kDofRightElbowZenith] = 0.19;
+  pose.dof[kDofRightElbowZenith] = 0.09;
   EXPECT_TRUE(ClampToJointLimits(&pose));
 
   // Brute force over arms anywhere, twisted or not, both sides: after the
-  // caps no forearm points more than 0.2 backwards, and a pose inside keeps
+  // caps no forearm points more than 0.1 backwards, and a pose inside keeps
   // every angle.
   std::mt19937 rng(11);
   // Drawn inside the other caps (the upper arm's cone, the elbow's 150 deg).
@@ -199,9 +199,9 @@ TEST(BodyModel, TheElbowDoesNotBendBackwards) {
     const BodyPose before = p;
     const bool inside = ClampToJointLimits(&p);
     const PosedBody body = PoseBody(shape, p);
-    EXPECT_GE(ForearmForward(body, kModelRightShoulder), -0.2 - 1e-9);
-    EXPECT_GE(ForearmForward(body, kModelLeftShoulder), -0.2 - 1e-9);
-    EXPECT_EQ(inside, right >= -0.2 - 1e-12 && left >= -0.2 - 1e-12) << i;
+    EXPECT_GE(ForearmForward(body, kModelRightShoulder), -0.1 - 1e-9);
+    EXPECT_GE(ForearmForward(body, kModelLeftShoulder), -0.1 - 1e-9);
+    EXPECT_EQ(inside, right >= -0.1 - 1e-12 && left >= -0.1 - 1e-12) << i;
     if (!inside) ++capped;
     for (int d = 0; d < kDofCount; ++d) {
       if (d == kDofRightElbowAzimuth || d == kDofLeftElbowAzimuth) continue;
