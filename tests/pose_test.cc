@@ -613,6 +613,13 @@ TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   jump.origin_m.z() += 0.2;
   EXPECT_FALSE(FeetOnFloor(jump, model_root, height, options));
   EXPECT_FALSE(FeetOnFloor(hull, model_root + Vector3d(0.8, 0, 0), height, options));
+  // How far the lowest part lies above the floor: under a voxel standing,
+  // 20 cm more in the jump, nothing where no leg is near the root.
+  const double standing_gap = FloorGap(hull, model_root, height, options);
+  EXPECT_LT(standing_gap, hull.voxel_size_m);
+  EXPECT_NEAR(FloorGap(jump, model_root, height, options), standing_gap + 0.2, 1e-9);
+  EXPECT_EQ(FloorGap(hull, model_root + Vector3d(0.8, 0, 0), height, options), 0.0);
+  EXPECT_EQ(FloorGap(EmptyStageHull(), model_root, height, options), 0.0);
 }
 
 // The top of the model: the highest point of its ellipsoids.
@@ -1124,6 +1131,58 @@ int FlippedFramesOverAStepBack(double step_max_speed_mps, uint64_t seed) {
     if (f >= 15 && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
   }
   return flipped;
+}
+
+// A model jumping 30 cm in place (frames 30-50, a parabola), its hull's
+// legs lifted with it: the tracked waist's largest error over the jump.
+double WaistErrorOverAJump(double min_floor_gap_m, uint64_t seed) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTrackerOptions options;
+  options.seed = seed;
+  options.min_floor_gap_m = min_floor_gap_m;
+  PoseTracker tracker(cams, {}, options);
+  const Vector2d forward = Vector2d::UnitX(), side(0, -1);
+  const double ankle_z = options.hull_legs.ankle * shape.height_m;
+  double worst = 0;
+  for (int f = 0; f < 70; ++f) {
+    const double t = std::clamp((f - 30) / 20.0, 0.0, 1.0);
+    const double lift = 1.2 * t * (1 - t);  // 0.3 m at the apex
+    BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), YawFacing(forward));
+    truth.dof[kDofZ] += lift;
+    FrameFeatures seen = ModelFeatures(cams, shape, truth, f);
+    VoxelHull hull = EmptyStageHull();
+    hull.nz = 40;
+    hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+    const Vector2d mid = PoseBody(shape, truth).joints[kModelRoot].head<2>();
+    FillHull(&hull, [&](const Vector3d& c) {
+      const double z = c.z() - lift;
+      for (double s : {-1.0, 1.0}) {
+        const Vector2d d = c.head<2>() - (mid + s * 0.11 * side);
+        if (z >= ankle_z && z < 0.5 && d.norm() < 0.055) return true;
+        if (z >= 0 && z < ankle_z && d.dot(forward) > -0.05 && d.dot(forward) < 0.19 &&
+            std::abs(d.dot(side)) < 0.045)
+          return true;
+      }
+      return false;
+    });
+    seen.voxels = hull;
+    const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
+    if (f >= 20) worst = std::max(worst, std::abs(e.pose.dof[kDofZ] - truth.dof[kDofZ]));
+  }
+  return worst;
+}
+
+TEST(PoseTracker, FollowsAJumpWhereTheHullLeavesTheFloor) {
+  for (uint64_t seed = 1; seed <= 2; ++seed) {
+    const double worst = WaistErrorOverAJump(PoseTrackerOptions().min_floor_gap_m, seed);
+    EXPECT_LT(worst, 0.06) << "seed " << seed;
+    std::printf("jump, seed %d: the waist at most %.1f cm off\n", int(seed), 100 * worst);
+  }
+  // Held to its standing height (the rule off), the waist stays low.
+  const double capped = WaistErrorOverAJump(10.0, 1);
+  EXPECT_GT(capped, 0.2);
+  std::printf("jump with the waist held down: %.1f cm off\n", 100 * capped);
 }
 
 TEST(PoseTracker, AStepBackIsNotAWalk) {

@@ -112,4 +112,22 @@ bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double heig
   return false;
 }
 
+double FloorGap(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
+                const HullLegsOptions& options) {
+  if (hull.voxel_size_m <= 0 || !(height_m > 0)) return 0.0;
+  const double r2 = options.radius_m * options.radius_m;
+  for (int z = 0; z < hull.nz; ++z) {
+    const double bottom = hull.VoxelCenter(0, 0, z).z() - 0.5 * hull.voxel_size_m;
+    if (bottom >= 0.5 * height_m) return 0.0;
+    for (int y = 0; y < hull.ny; ++y) {
+      for (int x = 0; x < hull.nx; ++x) {
+        if (!hull.Occupied(x, y, z)) continue;
+        if ((hull.VoxelCenter(x, y, z).head<2>() - root.head<2>()).squaredNorm() > r2) continue;
+        return std::max(0.0, bottom);
+      }
+    }
+  }
+  return 0.0;
+}
+
 }  // namespace irbench

@@ -92,4 +92,11 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
 bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
                  const HullLegsOptions& options = {});
 
+// How far above the floor the body's lowest part is: the bottom of the
+// lowest occupied voxel within radius_m of `root` (horizontally), 0 when
+// none lies below half the height `height_m` (nothing of the legs seen) or
+// the hull reaches the floor. A jump lifts it by the feet's height.
+double FloorGap(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
+                const HullLegsOptions& options = {});
+
 }  // namespace irbench

@@ -271,6 +271,11 @@ BodyPose BodyPositionProposal(const BodyPose& current,
   } else {
     PlaceRoot(context.shape, &next, context.features.placement->root.head<2>() + noise);
   }
+  // Off the floor (a jump): the waist as high above its standing height as
+  // the hull's lowest part above the floor.
+  if (context.floor_gap_m > 0) {
+    next.dof[kDofZ] = context.shape.waist_height_m + context.floor_gap_m + 0.02 * n01(rng);
+  }
   return next;
 }
 
@@ -333,7 +338,7 @@ BodyPose ProposeParticle(const BodyPose& current,
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
-  CapRise(context.shape, options.max_rise_m, &next);
+  CapRise(context.shape, options.max_rise_m + context.floor_gap_m, &next);
   return next;
 }
 
@@ -357,7 +362,8 @@ void RefineParticles(const BodyShape& shape,
                      const PoseScore& score,
                      std::mt19937_64& rng,
                      std::vector<BodyPose>* particles,
-                     std::vector<double>* log_likelihood) {
+                     std::vector<double>* log_likelihood,
+                     double floor_gap_m) {
   std::vector<BodyPose>& proposed = *particles;
   const int n = static_cast<int>(proposed.size());
   const int refine = static_cast<int>(std::round(options.refine_fraction * n));
@@ -371,7 +377,7 @@ void RefineParticles(const BodyShape& shape,
     cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
       for (int j = r.start; j < r.end && !CancelRequested(); ++j) {
         refined[j] = RefineIcp(shape, proposed[order[j]], icp_views, options.icp);
-        CapRise(shape, options.max_rise_m, &refined[j]);
+        CapRise(shape, options.max_rise_m + floor_gap_m, &refined[j]);
         refined_ll[j] = score(refined[j]);
       }
     });

@@ -59,6 +59,10 @@ struct ProposalContext {
   // The posture recognised in the frame-set before (PoseTracker::set_posture);
   // none: the posture proposal falls back to the random walk.
   std::optional<PostureBands> posture;
+  // How far the hull's lowest part lies above the floor (FloorGap): a jump.
+  // The waist may rise that much more than max_rise_m, and the body
+  // position proposal lifts the waist by it.
+  double floor_gap_m = 0;
 };
 
 // A particle's log-likelihood: the observation (thesis 6.3.1) plus the
@@ -137,7 +141,7 @@ std::vector<double> WeighParticles(const std::vector<BodyPose>& particles, const
 
 // Thesis 6.3.3, refine-prediction: 2D-3D ICP (icp.h) on a random subset of
 // round(options.refine_fraction * n) particles; a refined particle (its rise
-// capped) replaces its original, and its score the original's, when it
+// capped at max_rise_m + floor_gap_m) replaces its original, and its score the original's, when it
 // scores higher. Nothing without ICP iterations.
 void RefineParticles(const BodyShape& shape,
                      const std::vector<IcpView>& icp_views,
@@ -145,7 +149,8 @@ void RefineParticles(const BodyShape& shape,
                      const PoseScore& score,
                      std::mt19937_64& rng,
                      std::vector<BodyPose>* particles,
-                     std::vector<double>* log_likelihood);
+                     std::vector<double>* log_likelihood,
+                     double floor_gap_m = 0);
 
 // The index of the highest log-likelihood (the first of equals).
 int BestParticle(const std::vector<double>& log_likelihood);

@@ -312,7 +312,8 @@ std::vector<BodyPose> PoseTracker::ProposeParticles(const FrameFeatures& feature
                                   .walking = walking_,
                                   .entering = entering_,
                                   .lost = lost_,
-                                  .posture = posture_};
+                                  .posture = posture_,
+                                  .floor_gap_m = floor_gap_m_};
     for (size_t i = 0; i < particles_.size(); ++i) {
       proposed.push_back(ProposeParticle(particles_[i], previous_[i], dt, context, rng_));
     }
@@ -523,6 +524,15 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   MakeViews(features, &views, &icp_views);
   UpdateWalking(features.placement->root.head<2>(), dt);
   const std::vector<double> arm_diameters = ReadAxisPoints(features);
+  // Off the floor: the hull's lowest part more than a few voxels up (the
+  // floor layer of a standing user's hull starts at 0). Only for a user
+  // whole in every view: one walking off the stage loses the feet from the
+  // hull first.
+  floor_gap_m_ = 0;
+  if (features.voxels && InView(features.placement->root)) {
+    const double gap = FloorGap(*features.voxels, features.placement->root, shape_.height_m, options_.hull_legs);
+    if (gap >= options_.min_floor_gap_m) floor_gap_m_ = gap;
+  }
   std::vector<BodyPose> proposed = ProposeParticles(features, dt);
 
   // The particle filter (particle_filter.h): weights (thesis 6.3.1), then the
@@ -533,7 +543,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   std::vector<double> log_likelihood = WeighParticles(proposed, score);
   out.ms_observation = Millis(t_obs);
   const auto t_refine = std::chrono::steady_clock::now();
-  RefineParticles(shape_, icp_views, options_, score, rng_, &proposed, &log_likelihood);
+  RefineParticles(shape_, icp_views, options_, score, rng_, &proposed, &log_likelihood, floor_gap_m_);
   out.ms_refine = Millis(t_refine);
 
   const int best = BestParticle(log_likelihood);

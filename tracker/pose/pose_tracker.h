@@ -143,6 +143,8 @@ class PoseTracker {
   PoseTrackerOptions options_;
   std::mt19937_64 rng_;
   std::optional<PostureBands> posture_;
+  // This frame's FloorGap of the hull (a jump), 0 on the floor.
+  double floor_gap_m_ = 0;
   std::shared_ptr<const RestClassifier> rest_;
   Eigen::Vector2d facing_xy_ = Eigen::Vector2d::UnitY();
   // The feet's direction (HullLegs::toes), averaged over feet_memory_s; zero

@@ -65,6 +65,10 @@ struct PoseTrackerOptions {
   // lifted tall bodies 3-5 cm to fit their silhouettes, raising the head
   // that pointing rays start from. Crouching and bowing lower it freely.
   double max_rise_m = 0.02;
+  // ... unless the hull's lowest part lies at least min_floor_gap_m above
+  // the floor (a jump): then the waist may rise that much more, and the body
+  // position proposal lifts it by that (FloorGap, ProposalContext).
+  double min_floor_gap_m = 0.05;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
