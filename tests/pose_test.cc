@@ -1134,7 +1134,8 @@ int FlippedFramesOverAStepBack(double step_max_speed_mps, uint64_t seed) {
 }
 
 // A model jumping 30 cm in place (frames 30-50, a parabola), its hull's
-// legs lifted with it: the tracked waist's largest error over the jump.
+// legs lifted with it: the tracked waist's largest error while the feet are
+// at least 15 cm up (lower hops are below min_floor_gap_m).
 double WaistErrorOverAJump(double min_floor_gap_m, uint64_t seed) {
   const std::vector<Camera> cams = PinholeRig();
   const BodyShape shape = BodyShape::FromHeight(1.75);
@@ -1168,7 +1169,7 @@ double WaistErrorOverAJump(double min_floor_gap_m, uint64_t seed) {
     });
     seen.voxels = hull;
     const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
-    if (f >= 20) worst = std::max(worst, std::abs(e.pose.dof[kDofZ] - truth.dof[kDofZ]));
+    if (lift >= 0.15) worst = std::max(worst, std::abs(e.pose.dof[kDofZ] - truth.dof[kDofZ]));
   }
   return worst;
 }
@@ -1176,7 +1177,7 @@ double WaistErrorOverAJump(double min_floor_gap_m, uint64_t seed) {
 TEST(PoseTracker, FollowsAJumpWhereTheHullLeavesTheFloor) {
   for (uint64_t seed = 1; seed <= 2; ++seed) {
     const double worst = WaistErrorOverAJump(PoseTrackerOptions().min_floor_gap_m, seed);
-    EXPECT_LT(worst, 0.06) << "seed " << seed;
+    EXPECT_LT(worst, 0.05) << "seed " << seed;
     std::printf("jump, seed %d: the waist at most %.1f cm off\n", int(seed), 100 * worst);
   }
   // Held to its standing height (the rule off), the waist stays low.

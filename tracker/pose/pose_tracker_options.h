@@ -68,7 +68,7 @@ struct PoseTrackerOptions {
   // ... unless the hull's lowest part lies at least min_floor_gap_m above
   // the floor (a jump): then the waist may rise that much more, and the body
   // position proposal lifts it by that (FloorGap, ProposalContext).
-  double min_floor_gap_m = 0.05;
+  double min_floor_gap_m = 0.12;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
