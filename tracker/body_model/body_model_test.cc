@@ -209,6 +209,7 @@ TEST(BodyModel, TheElbowDoesNotBendBackwards) {
     }
     if (inside) {
       EXPECT_NEAR(p.dof[kDofRightElbowAzimuth], before.dof[kDofRightElbowAzimuth], 1e-12);
+      EXPECT_NEAR(p.dof[kDofLeftElbowAzimuth], before.dof[kDofLeftElbowAzimuth], 1e-12);
     }
   }
   EXPECT_GT(capped, 500);  // the draw does reach the forbidden range

@@ -141,8 +141,8 @@ std::vector<double> WeighParticles(const std::vector<BodyPose>& particles, const
 
 // Thesis 6.3.3, refine-prediction: 2D-3D ICP (icp.h) on a random subset of
 // round(options.refine_fraction * n) particles; a refined particle (its rise
-// capped at max_rise_m + floor_gap_m) replaces its original, and its score the original's, when it
-// scores higher. Nothing without ICP iterations.
+// capped at max_rise_m + floor_gap_m) replaces its original, and its score
+// the original's, when it scores higher. Nothing without ICP iterations.
 void RefineParticles(const BodyShape& shape,
                      const std::vector<IcpView>& icp_views,
                      const PoseTrackerOptions& options,
