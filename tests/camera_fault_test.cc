@@ -97,7 +97,11 @@ TEST_F(CameraFaultTest, ABlackOrFrozenCameraIsLeftOutWhileBadAndTrackingGoesOn) 
   for (const nlohmann::json& line : intact_track) EXPECT_TRUE(line["cameras_left_out"].empty()) << line["frame"];
   const Figures intact = Score(intact_track);
   EXPECT_GT(intact.Fraction(), 0.8);
-  EXPECT_LT(intact.mean_error_cm, 6.0);
+  // 6.27 cm since the elbows' backward cap (6.52 with a cap at 0.2, under
+  // 6.0 without): this p3 direct_traffic session is one of the library
+  // motions the cap costs; over the full suite it gains on real motion and
+  // is level on the library's over three seeds (docs/tracker.md, Body).
+  EXPECT_LT(intact.mean_error_cm, 6.5);
   const auto [first, end] = Span(1.5, 3.5);
   {
     // The side camera black from 1.5 s to 3.5 s: in the middle of the gesture.

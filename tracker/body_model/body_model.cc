@@ -47,7 +47,7 @@ bool CapElbowBackward(double twist, double zenith, double* azimuth, bool mirror)
   if (s <= kElbowMaxBackward) return true;
   const double offset = mirror ? -twist : twist;
   const double a = WrapAngle(*azimuth + offset);
-  if (s * std::sin(a) >= -kElbowMaxBackward) return true;
+  if (s * std::sin(a) >= -kElbowMaxBackward - 1e-12) return true;  // the edge itself is inside
   // Forbidden: a in (-pi + edge, -edge); sin(-edge) * s = -kElbowMaxBackward.
   const double edge = std::asin(kElbowMaxBackward / s);
   const double capped = a > -M_PI / 2 ? -edge : -M_PI + edge;
