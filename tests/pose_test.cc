@@ -1109,6 +1109,29 @@ TEST(PoseTracker, KeepsFacingWhereItWalkedUntilItTurns) {
   EXPECT_LE(total, 3);
 }
 
+// A hull of two legs standing at `mid` (the ankles' midpoint), `forward`
+// and `side` unit and horizontal, lifted by `lift`: vertical shins (5.5 cm
+// radius) from the ankles' height `ankle_z` to 0.5 m above each ankle, 11 cm
+// to each side, and feet from 5 cm behind to 19 cm ahead of each ankle.
+// `nz` layers of the stage's grid (the legs' estimate reads nothing higher).
+VoxelHull LegsHull(const Vector2d& mid, const Vector2d& side, const Vector2d& forward, double ankle_z, double lift,
+                   int nz) {
+  VoxelHull hull = EmptyStageHull();
+  hull.nz = nz;
+  hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
+  FillHull(&hull, [&](const Vector3d& c) {
+    const double z = c.z() - lift;
+    for (double s : {-1.0, 1.0}) {
+      const Vector2d d = c.head<2>() - (mid + s * 0.11 * side);
+      if (z >= ankle_z && z < 0.5 && d.norm() < 0.055) return true;
+      if (z >= 0 && z < ankle_z && d.dot(forward) > -0.05 && d.dot(forward) < 0.19 && std::abs(d.dot(side)) < 0.045)
+        return true;
+    }
+    return false;
+  });
+  return hull;
+}
+
 // A step back is not a walk: a model standing side-on to the screen (it is
 // towards +y) and facing +x, its hull's feet reaching forward of its
 // ankles, steps back 0.6 m at 0.6 m/s and stands again. The feet keep the
@@ -1132,20 +1155,8 @@ int FlippedFramesOverAStepBack(double step_max_speed_mps, uint64_t seed) {
     const BodyPose truth = StandingPose(shape, Vector2d(x, 0.2), yaw);
     FrameFeatures seen = ModelFeatures(cams, shape, truth, f);
     // Vertical shins above each ankle, and feet reaching 19 cm ahead of it.
-    VoxelHull hull = EmptyStageHull();
-    hull.nz = 26;  // up to 0.52 m: the legs' estimate reads nothing higher
-    hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
     const Vector2d mid = PoseBody(shape, truth).joints[kModelRoot].head<2>();
-    FillHull(&hull, [&](const Vector3d& c) {
-      for (double s : {-1.0, 1.0}) {
-        const Vector2d d = c.head<2>() - (mid + s * 0.11 * side);
-        if (c.z() >= ankle_z && c.z() < 0.5 && d.norm() < 0.055) return true;
-        if (c.z() < ankle_z && d.dot(forward) > -0.05 && d.dot(forward) < 0.19 && std::abs(d.dot(side)) < 0.045)
-          return true;
-      }
-      return false;
-    });
-    seen.voxels = hull;
+    seen.voxels = LegsHull(mid, side, forward, ankle_z, 0.0, 26);
     const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
     if (f >= 15 && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
   }
@@ -1171,22 +1182,8 @@ double WaistErrorOverAJump(double min_floor_gap_m, uint64_t seed) {
     BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), YawFacing(forward));
     truth.dof[kDofZ] += lift;
     FrameFeatures seen = ModelFeatures(cams, shape, truth, f);
-    VoxelHull hull = EmptyStageHull();
-    hull.nz = 40;
-    hull.occupied.assign(size_t(hull.nx) * hull.ny * hull.nz, 0);
     const Vector2d mid = PoseBody(shape, truth).joints[kModelRoot].head<2>();
-    FillHull(&hull, [&](const Vector3d& c) {
-      const double z = c.z() - lift;
-      for (double s : {-1.0, 1.0}) {
-        const Vector2d d = c.head<2>() - (mid + s * 0.11 * side);
-        if (z >= ankle_z && z < 0.5 && d.norm() < 0.055) return true;
-        if (z >= 0 && z < ankle_z && d.dot(forward) > -0.05 && d.dot(forward) < 0.19 &&
-            std::abs(d.dot(side)) < 0.045)
-          return true;
-      }
-      return false;
-    });
-    seen.voxels = hull;
+    seen.voxels = LegsHull(mid, side, forward, ankle_z, lift, 40);
     const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
     if (lift >= 0.15) worst = std::max(worst, std::abs(e.pose.dof[kDofZ] - truth.dof[kDofZ]));
   }

@@ -93,41 +93,50 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   return out;
 }
 
-bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
-                 const HullLegsOptions& options) {
-  if (hull.voxel_size_m <= 0) return false;
-  const double top = options.feet * height_m;
-  const double r2 = options.radius_m * options.radius_m;
-  int count = 0;
+namespace {
+
+// Visits the occupied voxels within radius_m of `root` (horizontally), layer
+// by layer from the floor up, while their layer's centre lies below top_m;
+// stops when `visit` (given the voxel's centre) returns true.
+template <typename Visit>
+void VisitLowVoxels(const VoxelHull& hull, const Eigen::Vector3d& root, double radius_m, double top_m, Visit visit) {
+  const double r2 = radius_m * radius_m;
   for (int z = 0; z < hull.nz; ++z) {
-    if (hull.VoxelCenter(0, 0, z).z() >= top) break;
+    if (hull.VoxelCenter(0, 0, z).z() >= top_m) return;
     for (int y = 0; y < hull.ny; ++y) {
       for (int x = 0; x < hull.nx; ++x) {
         if (!hull.Occupied(x, y, z)) continue;
-        if ((hull.VoxelCenter(x, y, z).head<2>() - root.head<2>()).squaredNorm() > r2) continue;
-        if (++count >= options.min_feet_voxels) return true;
+        const Eigen::Vector3d c = hull.VoxelCenter(x, y, z);
+        if ((c.head<2>() - root.head<2>()).squaredNorm() > r2) continue;
+        if (visit(c)) return;
       }
     }
   }
-  return false;
+}
+
+}  // namespace
+
+bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
+                 const HullLegsOptions& options) {
+  if (hull.voxel_size_m <= 0) return false;
+  int count = 0;
+  VisitLowVoxels(hull, root, options.radius_m, options.feet * height_m,
+                 [&](const Eigen::Vector3d&) { return ++count >= options.min_feet_voxels; });
+  return count >= options.min_feet_voxels;
 }
 
 double FloorGap(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
                 const HullLegsOptions& options) {
   if (hull.voxel_size_m <= 0 || !(height_m > 0)) return 0.0;
-  const double r2 = options.radius_m * options.radius_m;
-  for (int z = 0; z < hull.nz; ++z) {
-    const double bottom = hull.VoxelCenter(0, 0, z).z() - 0.5 * hull.voxel_size_m;
-    if (bottom >= 0.5 * height_m) return 0.0;
-    for (int y = 0; y < hull.ny; ++y) {
-      for (int x = 0; x < hull.nx; ++x) {
-        if (!hull.Occupied(x, y, z)) continue;
-        if ((hull.VoxelCenter(x, y, z).head<2>() - root.head<2>()).squaredNorm() > r2) continue;
-        return std::max(0.0, bottom);
-      }
-    }
-  }
-  return 0.0;
+  // A layer whose bottom lies at half the height or above has its centre
+  // half a voxel higher: such layers are not visited.
+  double gap = 0.0;
+  VisitLowVoxels(hull, root, options.radius_m, 0.5 * height_m + 0.5 * hull.voxel_size_m,
+                 [&](const Eigen::Vector3d& c) {
+                   gap = std::max(0.0, c.z() - 0.5 * hull.voxel_size_m);
+                   return true;
+                 });
+  return gap;
 }
 
 }  // namespace irbench
