@@ -177,10 +177,10 @@ void PoseTracker::Initialise(const FrameFeatures& features) {
   // frame on, so no single reading decides the heading. A user's first
   // frame is often one the feet misread: a dancer's foot lifted behind, a
   // crouch before a jump, a walk caught mid-stride. Taking the first reading
-  // as the average (as before) turned CMU mocap scenarios round from their
-  // first frame (full suite, tracker seeds 1 and 2: 5.5-6.4 % of tracked
-  // frames turned round, 4.1-4.3 % now; mocap arms -0.8 and -1.4 cm per
-  // scenario, library unchanged: docs/tracker.md).
+  // as the average (as before) turned 19 CMU mocap scenarios round from
+  // their first frame (full suite, tracker seeds 1 and 2: mocap arms -0.24
+  // and -1.35 cm per scenario, within the runs' spread; library unchanged:
+  // docs/tracker.md).
   feet_toes_ = Vector2d::Zero();
   const Vector2d to_screen = facing_xy_;
   std::normal_distribution<double> yaw_noise(0.0, 0.3), pos_noise(0.0, 0.03);
