@@ -1202,46 +1202,6 @@ TEST(PoseTracker, FollowsAJumpWhereTheHullLeavesTheFloor) {
   std::printf("jump with the waist held down: %.1f cm off\n", 100 * capped);
 }
 
-// A model facing the screen (+y, the default with no screens) whose first
-// frame-set's hull shows its feet reaching backwards (a foot lifted behind,
-// a crouch: CMU's dance and jump clips start so), the next 14 no feet on
-// the floor, every later one the feet forwards.
-// Returns the frames of the first 40 whose tracked heading lies more than
-// 90 deg from the truth's.
-int FlippedFramesAfterAMisreadFirstFrame(uint64_t seed) {
-  const std::vector<Camera> cams = PinholeRig();
-  const BodyShape shape = BodyShape::FromHeight(1.75);
-  PoseTrackerOptions options;
-  options.seed = seed;
-  PoseTracker tracker(cams, {}, options);
-  const Vector2d forward = Vector2d::UnitY(), side(1, 0);
-  const double yaw = YawFacing(forward);
-  const double ankle_z = options.hull_legs.ankle * shape.height_m;
-  const BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), yaw);
-  const Vector2d mid = PoseBody(shape, truth).joints[kModelRoot].head<2>();
-  int flipped = 0;
-  for (int f = 0; f < 40; ++f) {
-    FrameFeatures seen = ModelFeatures(cams, shape, truth, f);
-    // Frames 1-14: no floor layer (the feet 9 cm up), so no reading at all.
-    const double lift = f >= 1 && f < 15 ? ankle_z + 0.01 : 0.0;
-    seen.voxels = LegsHull(mid, side, f == 0 ? Vector2d(-forward) : forward, ankle_z, lift, 26);
-    const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
-    if (e.tracking && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
-  }
-  return flipped;
-}
-
-// No single reading of the feet decides the heading: their average starts
-// empty. (Taking the first reading as the average, as before, turned the
-// model round for 5 and 9 of these frames at seeds 1 and 2.)
-TEST(PoseTracker, OneMisreadFirstFrameOfTheFeetDoesNotTurnTheModelRound) {
-  for (uint64_t seed = 1; seed <= 2; ++seed) {
-    const int flipped = FlippedFramesAfterAMisreadFirstFrame(seed);
-    EXPECT_LE(flipped, 2) << "seed " << seed;
-    std::printf("feet misread in the first frame, seed %d: %d of 40 frames turned round\n", int(seed), flipped);
-  }
-}
-
 TEST(PoseTracker, AStepBackIsNotAWalk) {
   int total = 0;
   for (uint64_t seed = 1; seed <= 2; ++seed) {
