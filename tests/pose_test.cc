@@ -893,6 +893,42 @@ TEST(RestState, AnArmSeenHangingIsAtRestAndOneSeenLiftedIsNot) {
   }
 }
 
+// The truth's rule calls an arm lifted once its forearm is 45 deg or more
+// from straight down. Under a hanging upper arm the farthest axis point then
+// lies half the elbow's bend from down: an arm bent 60 deg forward reads 30
+// deg, inside the old limit of 34 deg, and was taken for hanging (issue 28:
+// a third of the CMU arm-frames wrongly at rest). The limit is half the
+// truth's forearm limit, 22.5 deg: such an arm is left to the SVM and the
+// filter, and a straight arm swung 20 deg is still at rest.
+TEST(RestState, AForearmBentForwardUnderAHangingUpperArmIsNotForcedToRest) {
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  for (int sh : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
+    truth.dof[sh] = 0.0;
+    truth.dof[sh + 1] = 0.05;
+    truth.dof[sh + 2] = 0.0;
+  }
+  truth.dof[kDofRightElbowAzimuth] = M_PI / 2;  // forward
+  truth.dof[kDofRightElbowZenith] = 50 * M_PI / 180;
+  truth.dof[kDofLeftShoulderZenith] = 20 * M_PI / 180;  // the left arm straight, 20 deg out
+  truth.dof[kDofLeftElbowAzimuth] = truth.dof[kDofLeftElbowZenith] = 0.0;
+  PoseTrackerOptions options;
+  options.seed = 7;
+  EXPECT_DOUBLE_EQ(options.rest_seen_max_angle_deg, 22.5);
+  const auto decisions = RestDecisions(options, truth, {true, true});
+  ASSERT_EQ(decisions.size(), 15u);
+  for (const auto& [right, left] : decisions) {
+    EXPECT_FALSE(right) << "the right forearm is bent 50 deg forward";
+    EXPECT_TRUE(left) << "the left arm hangs straight, 20 deg out";
+  }
+  // At the old limit the bent arm was at rest.
+  options.rest_seen_max_angle_deg = 34;
+  for (const auto& [right, left] : RestDecisions(options, truth, {true, true})) {
+    EXPECT_TRUE(right);
+    EXPECT_TRUE(left);
+  }
+}
+
 TEST(RestState, OptionsAreChecked) {
   PoseTrackerOptions options;
   EXPECT_NO_THROW(options.Check());

@@ -80,8 +80,14 @@ struct PoseTrackerOptions {
   // the tracked torso gives only to a few degrees: against it, seeds 1-5 of
   // the five demos made 251 errors in 25568 arm-frames, against straight
   // down 220, both before rest_lifted_memory_s. A user bowing deeply with
-  // hanging arms is taken for at rest.)
-  double rest_seen_max_angle_deg = 34;
+  // hanging arms is taken for at rest.) 22.5 deg, half the truth's forearm
+  // limit: under a hanging upper arm the farthest point lies about half the
+  // elbow's bend from down (more: forearm and hand outreach the upper arm),
+  // so an arm the truth calls lifted (forearm 45 deg or more) reads 22.5
+  // deg or more. At 34 deg (until 2026-12-06) forearms
+  // bent 45-90 deg forward under a hanging upper arm, common on real
+  // motion, were forced down (docs/tracker.md).
+  double rest_seen_max_angle_deg = 22.5;
   // An arm they do not show is at rest when forcing it down (to the best of
   // six hanging poses, which the estimate then shows) costs less than this
   // in the sum over cameras of log overlap ratio: the silhouettes cannot
@@ -89,7 +95,8 @@ struct PoseTrackerOptions {
   // the body, the silhouettes are visually nearly undistinguishable"). The
   // SVM, trained on exact joints, takes a hanging arm the filter has put at
   // the torso's side or behind it for a raised one. 0 turns the test off.
-  double rest_max_log_overlap_loss = 0.27;
+  // 0.15 since 2026-12-06 (0.27 before; docs/tracker.md).
+  double rest_max_log_overlap_loss = 0.15;
   // ... unless the axis points showed it lifted at least rest_lifted_angle_deg
   // from straight down within the last rest_lifted_memory_s: an arm does not
   // drop from there to the side unseen so fast; it has left the silhouettes
