@@ -895,7 +895,8 @@ TEST(RestState, AnArmSeenHangingIsAtRestAndOneSeenLiftedIsNot) {
 
 // The truth's rule calls an arm lifted once its forearm is 45 deg or more
 // from straight down. Under a hanging upper arm the farthest axis point then
-// lies half the elbow's bend from down: an arm bent 60 deg forward reads 30
+// lies about half the elbow's bend from down (a little more: forearm and
+// hand outreach the upper arm): an arm bent 50 deg forward reads about 28
 // deg, inside the old limit of 34 deg, and was taken for hanging (issue 28:
 // a third of the CMU arm-frames wrongly at rest). The limit is half the
 // truth's forearm limit, 22.5 deg: such an arm is left to the SVM and the
