@@ -1,7 +1,10 @@
 #include "tracker/pose/hull_legs.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "common/error.h"
@@ -26,70 +29,135 @@ void HullLegsOptions::Check() const {
   if (min_feet_voxels < 1) throw InputError("", where + ".min_feet_voxels", "must be at least 1");
 }
 
+namespace {
+
+// The centre of a layer's voxels (x, y): their centroid, or with `split` the
+// midpoint of the two groups that best split them along their principal
+// axis (1-D 2-means, solved exactly: the split of the sorted projections
+// with the least within-group squares). Two legs apart are then weighted
+// alike whatever voxels each holds (one seen by fewer views, a ghost
+// beside one), as the truth's midpoint of the ankles is; one blob's two
+// halves straddle its centre.
+Eigen::Vector2d LayerCentre(const std::vector<Eigen::Vector2d>& points, bool split) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  if (!split || points.size() < 2) return mean;
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector2d& p : points) cov += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(cov);
+  const Eigen::Vector2d axis = eigen.eigenvectors().col(1);  // the largest eigenvalue's
+  std::vector<std::pair<double, int>> along(points.size());
+  for (size_t i = 0; i < points.size(); ++i) along[i] = {(points[i] - mean).dot(axis), static_cast<int>(i)};
+  std::sort(along.begin(), along.end());
+  const int n = static_cast<int>(along.size());
+  std::vector<double> sum(n + 1, 0.0), sum2(n + 1, 0.0);
+  for (int i = 0; i < n; ++i) {
+    sum[i + 1] = sum[i] + along[i].first;
+    sum2[i + 1] = sum2[i] + along[i].first * along[i].first;
+  }
+  int best = 1;
+  double best_ss = std::numeric_limits<double>::infinity();
+  for (int k = 1; k < n; ++k) {  // the first k against the rest
+    const double low = sum2[k] - sum[k] * sum[k] / k;
+    const double high = (sum2[n] - sum2[k]) - (sum[n] - sum[k]) * (sum[n] - sum[k]) / (n - k);
+    if (low + high < best_ss) best_ss = low + high, best = k;
+  }
+  Eigen::Vector2d first = Eigen::Vector2d::Zero(), second = Eigen::Vector2d::Zero();
+  for (int i = 0; i < n; ++i) (i < best ? first : second) += points[along[i].second];
+  return (first / best + second / (n - best)) / 2;
+}
+
+// The ankles' midpoint from the layers' centres (LayerCentre): the lean, a
+// least-squares line of the centres against their heights, capped at
+// max_lean; the lowest layers' (below anchor_high) centre carried down the
+// lean to the ankles' height `ankle_z` (a kink at the knee or a calf seen
+// by fewer views bends the upper layers: the lean from them is trusted only
+// so far). nullopt with fewer than min_layers layers or a lean beyond
+// max_slope. `layers`: the layers fitted.
+std::optional<Eigen::Vector2d> AnklesFromLayers(const std::vector<std::vector<Eigen::Vector2d>>& layer_points,
+                                                bool split, double low, double ankle_z, double height_m,
+                                                const HullLegsOptions& options, int* layers) {
+  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+  Eigen::Matrix2d atb = Eigen::Matrix2d::Zero();  // columns x, y
+  Eigen::Vector2d anchor = Eigen::Vector2d::Zero();
+  double anchor_z = 0;
+  int anchor_layers = 0;
+  *layers = 0;
+  for (size_t i = 0; i < layer_points.size(); ++i) {
+    if (static_cast<int>(layer_points[i].size()) < options.min_layer_voxels) continue;
+    const Eigen::Vector2d centre = LayerCentre(layer_points[i], split);
+    const double z = low + (static_cast<double>(i) + 0.5) * options.layer_m;
+    const Eigen::Vector2d a(1.0, z - ankle_z);
+    ata += a * a.transpose();
+    atb += a * centre.transpose();
+    ++*layers;
+    if (z < options.anchor_high * height_m) {
+      anchor += centre;
+      anchor_z += z;
+      ++anchor_layers;
+    }
+  }
+  if (*layers < options.min_layers || anchor_layers == 0 || std::abs(ata.determinant()) < 1e-12) return std::nullopt;
+  const Eigen::Matrix2d line = ata.ldlt().solve(atb);  // row 0: intercept (x, y); row 1: slope
+  Eigen::Vector2d lean = line.row(1).transpose();
+  if (lean.norm() > options.max_slope) return std::nullopt;
+  if (lean.norm() > options.max_lean) lean *= options.max_lean / lean.norm();
+  return Eigen::Vector2d(anchor / anchor_layers - lean * (anchor_z / anchor_layers - ankle_z));
+}
+
+}  // namespace
+
 std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vector3d& model_root,
                                         const Eigen::Vector3d& forward, double height_m,
                                         const HullLegsOptions& options) {
   if (!(height_m > 0)) return std::nullopt;
   const double low = options.low * height_m, high = options.high * height_m;
   const int layer_count = std::max(1, static_cast<int>(std::floor((high - low) / options.layer_m)));
-  std::vector<Eigen::Vector2d> sums(layer_count, Eigen::Vector2d::Zero());
-  std::vector<int> counts(layer_count, 0);
-  Eigen::Vector2d feet_sum = Eigen::Vector2d::Zero();
-  int feet_count = 0;
+  std::vector<std::vector<Eigen::Vector2d>> layer_points(layer_count);
+  std::vector<Eigen::Vector2d> feet_points;
   const double r2 = options.radius_m * options.radius_m;
   for (const Eigen::Vector3d& c : hull.OccupiedCenters()) {
     if (c.z() >= low + layer_count * options.layer_m) continue;
     if ((c.head<2>() - model_root.head<2>()).squaredNorm() > r2) continue;
-    if (c.z() < options.feet * height_m) {
-      feet_sum += c.head<2>();
-      ++feet_count;
-    }
+    if (c.z() < options.feet * height_m) feet_points.push_back(c.head<2>());
     if (c.z() < low) continue;
     const int layer = static_cast<int>((c.z() - low) / options.layer_m);
     if (layer < 0 || layer >= layer_count) continue;
-    sums[layer] += c.head<2>();
-    ++counts[layer];
+    layer_points[layer].push_back(c.head<2>());
   }
-  // The lean: least squares of the layers' centroids against their heights,
-  // capped at max_lean. The ankles: the lowest layers' centroid carried down
-  // the lean to the ankles' height (a kink at the knee or a calf seen by
-  // fewer views bends the upper layers: the lean from them is trusted only
-  // so far).
+  // The ankles from the voxels' centroids: the feet's direction is read
+  // from these (below). The root from the layers' two-leg midpoints
+  // (split_legs) where they give one.
   const double ankle_z = options.ankle * height_m;
-  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
-  Eigen::Matrix2d atb = Eigen::Matrix2d::Zero();  // columns x, y
-  Eigen::Vector2d anchor = Eigen::Vector2d::Zero();
-  double anchor_z = 0;
-  int layers = 0, anchor_layers = 0;
-  for (int i = 0; i < layer_count; ++i) {
-    if (counts[i] < options.min_layer_voxels) continue;
-    const Eigen::Vector2d centroid = sums[i] / counts[i];
-    const double z = low + (i + 0.5) * options.layer_m;
-    const Eigen::Vector2d a(1.0, z - ankle_z);
-    ata += a * a.transpose();
-    atb += a * centroid.transpose();
-    ++layers;
-    if (z < options.anchor_high * height_m) {
-      anchor += centroid;
-      anchor_z += z;
-      ++anchor_layers;
-    }
-  }
-  if (layers < options.min_layers || anchor_layers == 0 || std::abs(ata.determinant()) < 1e-12) return std::nullopt;
-  const Eigen::Matrix2d line = ata.ldlt().solve(atb);  // row 0: intercept (x, y); row 1: slope
-  Eigen::Vector2d lean = line.row(1).transpose();
-  if (lean.norm() > options.max_slope) return std::nullopt;
-  if (lean.norm() > options.max_lean) lean *= options.max_lean / lean.norm();
-  const Eigen::Vector2d ankles = anchor / anchor_layers - lean * (anchor_z / anchor_layers - ankle_z);
+  int layers = 0;
+  const std::optional<Eigen::Vector2d> ankles =
+      AnklesFromLayers(layer_points, false, low, ankle_z, height_m, options, &layers);
+  if (!ankles) return std::nullopt;
   Eigen::Vector2d facing = forward.head<2>();
   facing = facing.norm() > 1e-9 ? facing.normalized() : Eigen::Vector2d::Zero();
-  const Eigen::Vector2d measured = ankles + options.calf * height_m * facing;
-  if ((measured - model_root.head<2>()).norm() > options.max_offset_m) return std::nullopt;
-  const Eigen::Vector2d root = model_root.head<2>() + options.weight * (measured - model_root.head<2>());
+  const auto near_model = [&](const Eigen::Vector2d& ankles_xy) -> std::optional<Eigen::Vector2d> {
+    const Eigen::Vector2d measured = ankles_xy + options.calf * height_m * facing;
+    if ((measured - model_root.head<2>()).norm() > options.max_offset_m) return std::nullopt;
+    return measured;
+  };
+  std::optional<Eigen::Vector2d> measured = near_model(*ankles);
+  if (!measured) return std::nullopt;
+  if (options.split_legs) {
+    int split_layers = 0;
+    const auto split = AnklesFromLayers(layer_points, true, low, ankle_z, height_m, options, &split_layers);
+    if (split && near_model(*split)) measured = near_model(*split);
+  }
+  const Eigen::Vector2d root = model_root.head<2>() + options.weight * (*measured - model_root.head<2>());
   HullLegs out;
+  out.measured = Eigen::Vector3d(measured->x(), measured->y(), 0.0);
   out.root = Eigen::Vector3d(root.x(), root.y(), 0.0);
   out.layers = layers;
-  if (feet_count >= options.min_feet_voxels) out.toes = feet_sum / feet_count - ankles;
+  if (static_cast<int>(feet_points.size()) >= options.min_feet_voxels) {
+    Eigen::Vector2d feet = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : feet_points) feet += p;
+    out.toes = feet / static_cast<double>(feet_points.size()) - *ankles;
+  }
   return out;
 }
 

@@ -7,13 +7,14 @@
 // that way. On CMU motion capture the waist stood 6-14 cm ahead of the
 // ankles (knees bent, the shins leaning forward), and the tracked root was
 // 8-15 cm off with a steady forward bias (issue 28). The hull's lower legs
-// show where the ankles are: the centroids of thin horizontal layers of the
-// hull between the feet and the knees (both legs together) move along a
-// line as the shins lean; the lowest layers' centroid carried down that
-// lean to the ankles' height is the ankles' midpoint. The feet, below it,
-// reach forward of the ankles: the floor layer's centroid minus that point
-// shows the way the person faces, which the silhouettes higher up cannot
-// tell from its reverse.
+// show where the ankles are: the centres of thin horizontal layers of the
+// hull between the feet and the knees (both legs together; for the root
+// each layer's centre is the midpoint of its two legs, split_legs) move
+// along a line as the shins lean; the lowest layers' centre carried down
+// that lean to the ankles' height is the ankles' midpoint. The feet, below
+// it, reach forward of the ankles: the floor layer's centroid minus that
+// point (from the layers' centroids) shows the way the person faces, which
+// the silhouettes higher up cannot tell from its reverse.
 //
 // Measured against the truth's root on the first 240 frames of 8 renders
 // (thesis preset; an offline replica of this estimate on the tracker's voxel
@@ -65,6 +66,11 @@ struct HullLegsOptions {
   // measured one (two estimates with their own errors; 0.7-1 measured alike,
   // 0.8 best on the library motions and the CMU clips together).
   double weight = 0.8;
+  // The root from the layers' centres taken as the midpoints of their two
+  // halves split along their principal axes, not the voxels' centroids: two
+  // legs apart count alike however many voxels each holds. (The feet's
+  // direction keeps the centroids.)
+  bool split_legs = true;
   // The floor layer, for the feet's direction: 0 to feet of the height.
   double feet = 0.035;
   int min_feet_voxels = 10;
@@ -72,9 +78,13 @@ struct HullLegsOptions {
 };
 
 struct HullLegs {
-  Eigen::Vector3d root = Eigen::Vector3d::Zero();  // z = 0
-  // The floor layer's centroid minus the ankles' midpoint (before the calf
-  // correction), metres; nullopt when the floor layer has too few voxels.
+  // The root measured (the ankles' midpoint with the calf correction), and
+  // the root reported: the model's moved `weight` of the way there; z = 0.
+  Eigen::Vector3d measured = Eigen::Vector3d::Zero();
+  Eigen::Vector3d root = Eigen::Vector3d::Zero();
+  // The floor layer's centroid minus the ankles' midpoint (from the layers'
+  // centroids, before the calf correction), metres; nullopt when the floor
+  // layer has too few voxels.
   std::optional<Eigen::Vector2d> toes;
   int layers = 0;  // layers in the fit
 };
