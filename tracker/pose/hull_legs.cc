@@ -146,7 +146,7 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   if (options.split_legs) {
     int split_layers = 0;
     const auto split = AnklesFromLayers(layer_points, true, low, ankle_z, height_m, options, &split_layers);
-    if (split && near_model(*split)) measured = near_model(*split);
+    if (const auto from_split = split ? near_model(*split) : std::nullopt) measured = from_split;
   }
   const Eigen::Vector2d root = model_root.head<2>() + options.weight * (*measured - model_root.head<2>());
   HullLegs out;
@@ -154,9 +154,7 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   out.root = Eigen::Vector3d(root.x(), root.y(), 0.0);
   out.layers = layers;
   if (static_cast<int>(feet_points.size()) >= options.min_feet_voxels) {
-    Eigen::Vector2d feet = Eigen::Vector2d::Zero();
-    for (const Eigen::Vector2d& p : feet_points) feet += p;
-    out.toes = feet / static_cast<double>(feet_points.size()) - *ankles;
+    out.toes = LayerCentre(feet_points, false) - *ankles;
   }
   return out;
 }
