@@ -150,7 +150,6 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   }
   const Eigen::Vector2d root = model_root.head<2>() + options.weight * (*measured - model_root.head<2>());
   HullLegs out;
-  out.measured = Eigen::Vector3d(measured->x(), measured->y(), 0.0);
   out.root = Eigen::Vector3d(root.x(), root.y(), 0.0);
   out.layers = layers;
   if (static_cast<int>(feet_points.size()) >= options.min_feet_voxels) {

@@ -78,10 +78,7 @@ struct HullLegsOptions {
 };
 
 struct HullLegs {
-  // The root measured (the ankles' midpoint with the calf correction), and
-  // the root reported: the model's moved `weight` of the way there; z = 0.
-  Eigen::Vector3d measured = Eigen::Vector3d::Zero();
-  Eigen::Vector3d root = Eigen::Vector3d::Zero();
+  Eigen::Vector3d root = Eigen::Vector3d::Zero();  // z = 0
   // The floor layer's centroid minus the ankles' midpoint (from the layers'
   // centroids, before the calf correction), metres; nullopt when the floor
   // layer has too few voxels.
