@@ -872,6 +872,16 @@ std::vector<std::array<bool, 2>> RestDecisions(const PoseTrackerOptions& options
   return decisions;
 }
 
+// Expects each of `decisions` ({right, left} at rest) to be {right, left};
+// `right_why` and `left_why` name the arms in a failure.
+void ExpectEveryDecision(const std::vector<std::array<bool, 2>>& decisions, bool right, bool left,
+                         const char* right_why = "", const char* left_why = "") {
+  for (const auto& [r, l] : decisions) {
+    EXPECT_EQ(r, right) << right_why;
+    EXPECT_EQ(l, left) << left_why;
+  }
+}
+
 // Thesis 6.4: silhouettes cannot tell an arm wrapped near the body from a
 // hanging one. Besides the SVM, an arm the axis points do not show is at rest
 // when forcing it down costs the estimate next to nothing
@@ -886,16 +896,11 @@ TEST(RestState, AnArmTheSilhouettesCannotTellFromHangingIsAtRest) {
   // The front end sees the raised right arm, not the hanging left one.
   const auto with_test = RestDecisions(options, truth, {true, false});
   ASSERT_EQ(with_test.size(), 15u);
-  for (const auto& [right, left] : with_test) {
-    EXPECT_FALSE(right) << "the raised right arm is not at rest";
-    EXPECT_TRUE(left) << "the hanging left arm is at rest";
-  }
+  ExpectEveryDecision(with_test, false, true, "the raised right arm is not at rest",
+                      "the hanging left arm is at rest");
   // Without the test the SVM alone decides, and it finds neither arm at rest.
   options.rest_max_log_overlap_loss = 0;
-  for (const auto& [right, left] : RestDecisions(options, truth, {true, false})) {
-    EXPECT_FALSE(right);
-    EXPECT_FALSE(left);
-  }
+  ExpectEveryDecision(RestDecisions(options, truth, {true, false}), false, false);
 }
 
 // An arm the 3D axis points show apart from the body is at rest when they
@@ -919,16 +924,11 @@ TEST(RestState, AnArmSeenHangingIsAtRestAndOneSeenLiftedIsNot) {
   options.rest_max_log_overlap_loss = 1e9;  // passes any arm it is run on
   const auto decisions = RestDecisions(options, truth, {true, true});
   ASSERT_EQ(decisions.size(), 15u);
-  for (const auto& [right, left] : decisions) {
-    EXPECT_TRUE(right) << "the right arm hangs 20 deg from straight down";
-    EXPECT_FALSE(left) << "the left arm is lifted 38 deg";
-  }
+  ExpectEveryDecision(decisions, true, false, "the right arm hangs 20 deg from straight down",
+                      "the left arm is lifted 38 deg");
   // At a limit of 15 deg neither is at rest.
   options.rest_seen_max_angle_deg = 15;
-  for (const auto& [right, left] : RestDecisions(options, truth, {true, true})) {
-    EXPECT_FALSE(right);
-    EXPECT_FALSE(left);
-  }
+  ExpectEveryDecision(RestDecisions(options, truth, {true, true}), false, false);
 }
 
 // The truth's rule calls an arm lifted once its forearm is 45 deg or more
@@ -956,16 +956,11 @@ TEST(RestState, AForearmBentForwardUnderAHangingUpperArmIsNotForcedToRest) {
   EXPECT_DOUBLE_EQ(options.rest_seen_max_angle_deg, 22.5);
   const auto decisions = RestDecisions(options, truth, {true, true});
   ASSERT_EQ(decisions.size(), 15u);
-  for (const auto& [right, left] : decisions) {
-    EXPECT_FALSE(right) << "the right forearm is bent 50 deg forward";
-    EXPECT_TRUE(left) << "the left arm hangs straight, 20 deg out";
-  }
+  ExpectEveryDecision(decisions, false, true, "the right forearm is bent 50 deg forward",
+                      "the left arm hangs straight, 20 deg out");
   // At the old limit the bent arm was at rest.
   options.rest_seen_max_angle_deg = 34;
-  for (const auto& [right, left] : RestDecisions(options, truth, {true, true})) {
-    EXPECT_TRUE(right);
-    EXPECT_TRUE(left);
-  }
+  ExpectEveryDecision(RestDecisions(options, truth, {true, true}), true, true);
 }
 
 TEST(RestState, OptionsAreChecked) {
