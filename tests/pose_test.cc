@@ -1293,5 +1293,48 @@ TEST(PoseTracker, AStepBackIsNotAWalk) {
   EXPECT_THROW(bad.Check(), InputError);
 }
 
+// A step back that nothing but its length tells from a walk: a model
+// side-on to the screen (it is towards +y) and facing +x, with no hull to
+// show its feet, stands for 2 s, steps back 0.3 m at 0.6 m/s (frames
+// 60-75) and stands again. Returns the frames from frame 15 on whose
+// tracked heading lies more than 90 deg from the truth's.
+int FlippedFramesOverAShortStepBack(double step_back_max_s, uint64_t seed) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTrackerOptions options;
+  options.seed = seed;
+  options.step_back_max_s = step_back_max_s;
+  PoseTracker tracker(cams, {}, options);
+  const double yaw = YawFacing(Vector2d::UnitX());
+  int flipped = 0;
+  for (int f = 0; f < 150; ++f) {
+    const double x = 0.3 - 0.3 * std::clamp((f - 60) / 15.0, 0.0, 1.0);
+    const BodyPose truth = StandingPose(shape, Vector2d(x, 0.2), yaw);
+    const PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30);
+    if (f >= 15 && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
+  }
+  return flipped;
+}
+
+TEST(PoseTracker, AShortStepBackDoesNotTurnTheModelRound) {
+  int total = 0;
+  for (uint64_t seed = 1; seed <= 2; ++seed) {
+    const int flipped = FlippedFramesOverAShortStepBack(PoseTrackerOptions().step_back_max_s, seed);
+    EXPECT_LE(flipped, 2) << "seed " << seed;
+    total += flipped;
+  }
+  // Taken for a walk (the rule off), the step turns the model round.
+  const int as_walk = FlippedFramesOverAShortStepBack(0.0, 1);
+  EXPECT_GE(as_walk, 30);
+  std::printf("short step back: %d frames turned round over seeds 1-2; %d of 135 with the rule off\n", total,
+              as_walk);
+  PoseTrackerOptions bad;
+  bad.step_back_max_s = -1;
+  EXPECT_THROW(bad.Check(), InputError);
+  bad = PoseTrackerOptions();
+  bad.heading_settled_s = std::nan("");
+  EXPECT_THROW(bad.Check(), InputError);
+}
+
 }  // namespace
 }  // namespace irbench

@@ -261,7 +261,14 @@ void PoseTracker::UpdateWalking(const Eigen::Vector2d& root_xy, double dt) {
       if (steady && IsStep(velocity_xy_)) steady = false;
     }
     moving_frames_ = steady ? moving_frames_ + 1 : 0;
-    walking_ = moving_frames_ >= 2;
+    // A move against the way the estimate faces is taken for a step back
+    // until it has lasted step_back_max_s, once the heading has settled.
+    int needed = 2;
+    if (steady && last_yaw_ && tracked_s_ >= options_.heading_settled_s &&
+        FacingDirection(*last_yaw_).dot(velocity_xy_) < 0) {
+      needed = std::max(needed, static_cast<int>(std::lround(options_.step_back_max_s / std::max(dt, 1e-3))));
+    }
+    walking_ = moving_frames_ >= needed;
   } else {
     moving_frames_ = 0;
   }
@@ -514,6 +521,8 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   left_out_ = features.left_out;
   if (!features.placement || features.cameras.size() != cameras_.size()) {
     active_ = false;
+    last_yaw_.reset();
+    tracked_s_ = 0;
     lost_ = false;
     lifted_age_s_ = {kNever, kNever};
     out.ms_total = Millis(start);
@@ -552,6 +561,8 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   out.shape = shape_;
   out.body = PoseBody(shape_, out.pose);
   if (!out.tracking) lifted_age_s_ = {kNever, kNever};
+  last_yaw_ = out.tracking ? std::optional<double>(out.pose.dof[kDofYaw]) : std::nullopt;
+  tracked_s_ = out.tracking ? tracked_s_ + dt : 0;
   if (out.tracking && rest_ && !rest_->empty()) DecideRest(proposed, log_likelihood, best, views, dt, &out);
   MeasureLegs(features, dt, &out);
   HeadAndPointing(features, views, &out);

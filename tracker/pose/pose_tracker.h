@@ -174,6 +174,10 @@ class PoseTracker {
   Eigen::Vector2d velocity_xy_ = Eigen::Vector2d::Zero();
   bool walking_ = false;
   int moving_frames_ = 0;
+  // The yaw of the last tracked estimate, while tracking goes on.
+  std::optional<double> last_yaw_;
+  // Seconds tracked without a break (0 before the first tracked frame).
+  double tracked_s_ = 0;
   // The last walking direction and how much of it the heading prior still
   // holds (1 while walking, down to 0 over walk_memory_s).
   Eigen::Vector2d walk_dir_ = Eigen::Vector2d::UnitX();

@@ -54,6 +54,8 @@ void PoseTrackerOptions::Check() const {
   if (!(step_max_speed_mps >= 0)) throw InputError("", "pose.step_max_speed_mps", "must be non-negative");
   if (!(step_feet_angle_deg >= 0 && step_feet_angle_deg <= 180))
     throw InputError("", "pose.step_feet_angle_deg", "must be in [0, 180]");
+  if (!(step_back_max_s >= 0)) throw InputError("", "pose.step_back_max_s", "must be non-negative");
+  if (!(heading_settled_s >= 0)) throw InputError("", "pose.heading_settled_s", "must be non-negative");
   if (height_frames < 1) throw InputError("", "pose.height_frames", "must be at least 1");
   if (!(height_max_lean_deg > 0 && height_max_lean_deg <= 90))
     throw InputError("", "pose.height_max_lean_deg", "must be in (0, 90]");

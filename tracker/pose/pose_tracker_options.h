@@ -140,6 +140,18 @@ struct PoseTrackerOptions {
   // average under 4 cm). heading_from_feet false turns it off.
   double step_max_speed_mps = 0.9;
   double step_feet_angle_deg = 60;
+  // A steady move against the way the last estimate faced (more than 90 deg
+  // from it) is a step back, not a walk, for its first step_back_max_s
+  // (the walk's forced turn and heading prior would turn the model round),
+  // once the user has been tracked for heading_settled_s without a break:
+  // before that the heading is the priors' guess and a walk is the first
+  // evidence of it (dancers in CMU 05_14 and 05_15 walk off within 1 s of
+  // being seen, facing away from the screen). Laughing and hopping CMU
+  // subjects (13_14, 13_10, 131_03) step back at 0.5-0.8 m/s for 3-7
+  // frames, and the model stayed turned round for 13-39 frames after each.
+  // step_back_max_s 0 turns it off.
+  double step_back_max_s = 0.3;
+  double heading_settled_s = 1.5;
   // Tracking is declared when the voxel hull sees a person and the best
   // particle's mean overlap ratio reaches this.
   double min_overlap = 0.35;
