@@ -1142,29 +1142,43 @@ TEST(PoseTracker, ThePostureProposalMovesTheArmsIntoTheRecognisedPosture) {
 namespace irbench {
 namespace {
 
+// Tracks a 1.75 m model posed by `truth(frame, shape)` for `frames` frame-sets
+// at 30 fps on the pinhole rig, with no screens (the screen is towards +y),
+// from the model's features and, where `legs` is given, the hull it returns
+// for the truth's pose. Returns the frames from `first` on whose tracked
+// heading lies more than 90 deg from the truth's.
+int TurnedRoundFrames(const PoseTrackerOptions& options, int frames, int first,
+                      const std::function<BodyPose(int, const BodyShape&)>& truth,
+                      const std::function<VoxelHull(const BodyPose&, const BodyShape&)>& legs = {}) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTracker tracker(cams, {}, options);
+  int turned = 0;
+  for (int f = 0; f < frames; ++f) {
+    const BodyPose pose = truth(f, shape);
+    FrameFeatures seen = ModelFeatures(cams, shape, pose, f);
+    if (legs) seen.voxels = legs(pose, shape);
+    const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
+    if (f >= first && std::cos(e.pose.dof[kDofYaw] - pose.dof[kDofYaw]) < 0) ++turned;
+  }
+  return turned;
+}
+
 // Front and back look alike: a model that walks along +x and then stands
 // side-on to the screen before turning to it must keep facing where it
 // walked (the walk's heading memory), never flip half way round. Without the
 // memory (walk_memory_s ~ 0) this case flipped for 38 of its 96 frames.
 int FlippedFramesAfterAWalk(double walk_memory_s, uint64_t seed = 7) {
-  const std::vector<Camera> cams = PinholeRig();
-  const BodyShape shape = BodyShape::FromHeight(1.75);
   PoseTrackerOptions options;
   options.seed = seed;
   options.walk_memory_s = walk_memory_s;
-  PoseTracker tracker(cams, {}, options);  // no screens: the screen is towards +y
   const double walk_yaw = YawFacing(Vector2d::UnitX()), screen_yaw = YawFacing(Vector2d::UnitY());
-  int flipped = 0;
-  for (int f = 0; f < 120; ++f) {
-    BodyPose truth;
-    double x = -0.8 + std::min(f, 36) / 30.0;  // 1 m/s for 1.2 s, then standing
+  return TurnedRoundFrames(options, 120, 24, [&](int f, const BodyShape& shape) {
+    const double x = -0.8 + std::min(f, 36) / 30.0;  // 1 m/s for 1.2 s, then standing
     double yaw = walk_yaw;
     if (f >= 75) yaw = walk_yaw + WrapAngle(screen_yaw - walk_yaw) * std::min(1.0, (f - 75) / 30.0);
-    truth = StandingPose(shape, Vector2d(x, 0.3), yaw);
-    const PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30);
-    if (f >= 24 && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
-  }
-  return flipped;
+    return StandingPose(shape, Vector2d(x, 0.3), yaw);
+  });
 }
 
 // Over filter seeds 1-12, at most one frame in 96 flips (seeds 2 and 12);
@@ -1210,27 +1224,22 @@ VoxelHull LegsHull(const Vector2d& mid, const Vector2d& side, const Vector2d& fo
 // the frames from the step on. Returns the frames whose tracked heading
 // lies more than 90 deg from the truth's.
 int FlippedFramesOverAStepBack(double step_max_speed_mps, uint64_t seed) {
-  const std::vector<Camera> cams = PinholeRig();
-  const BodyShape shape = BodyShape::FromHeight(1.75);
   PoseTrackerOptions options;
   options.seed = seed;
   options.step_max_speed_mps = step_max_speed_mps;
-  PoseTracker tracker(cams, {}, options);
   const Vector2d forward = Vector2d::UnitX(), side(0, -1);
   const double yaw = YawFacing(forward);
-  const double ankle_z = options.hull_legs.ankle * shape.height_m;
-  int flipped = 0;
-  for (int f = 0; f < 100; ++f) {
-    const double x = 0.3 - 0.6 * std::clamp((f - 20) / 30.0, 0.0, 1.0);  // 0.6 m/s back over frames 20-50
-    const BodyPose truth = StandingPose(shape, Vector2d(x, 0.2), yaw);
-    FrameFeatures seen = ModelFeatures(cams, shape, truth, f);
-    // Vertical shins above each ankle, and feet reaching 19 cm ahead of it.
-    const Vector2d mid = PoseBody(shape, truth).joints[kModelRoot].head<2>();
-    seen.voxels = LegsHull(mid, side, forward, ankle_z, 0.0, 26);
-    const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
-    if (f >= 15 && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
-  }
-  return flipped;
+  return TurnedRoundFrames(
+      options, 100, 15,
+      [&](int f, const BodyShape& shape) {
+        const double x = 0.3 - 0.6 * std::clamp((f - 20) / 30.0, 0.0, 1.0);  // 0.6 m/s back over frames 20-50
+        return StandingPose(shape, Vector2d(x, 0.2), yaw);
+      },
+      [&](const BodyPose& pose, const BodyShape& shape) {
+        // Vertical shins above each ankle, and feet reaching 19 cm ahead of it.
+        const Vector2d mid = PoseBody(shape, pose).joints[kModelRoot].head<2>();
+        return LegsHull(mid, side, forward, options.hull_legs.ankle * shape.height_m, 0.0, 26);
+      });
 }
 
 // A model jumping 30 cm in place (frames 30-50, a parabola), its hull's
@@ -1299,21 +1308,13 @@ TEST(PoseTracker, AStepBackIsNotAWalk) {
 // 60-75) and stands again. Returns the frames from frame 15 on whose
 // tracked heading lies more than 90 deg from the truth's.
 int FlippedFramesOverAShortStepBack(double step_back_max_s, uint64_t seed) {
-  const std::vector<Camera> cams = PinholeRig();
-  const BodyShape shape = BodyShape::FromHeight(1.75);
   PoseTrackerOptions options;
   options.seed = seed;
   options.step_back_max_s = step_back_max_s;
-  PoseTracker tracker(cams, {}, options);
-  const double yaw = YawFacing(Vector2d::UnitX());
-  int flipped = 0;
-  for (int f = 0; f < 150; ++f) {
+  return TurnedRoundFrames(options, 150, 15, [](int f, const BodyShape& shape) {
     const double x = 0.3 - 0.3 * std::clamp((f - 60) / 15.0, 0.0, 1.0);
-    const BodyPose truth = StandingPose(shape, Vector2d(x, 0.2), yaw);
-    const PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, f), 1.0 / 30);
-    if (f >= 15 && std::cos(e.pose.dof[kDofYaw] - yaw) < 0) ++flipped;
-  }
-  return flipped;
+    return StandingPose(shape, Vector2d(x, 0.2), YawFacing(Vector2d::UnitX()));
+  });
 }
 
 TEST(PoseTracker, AShortStepBackDoesNotTurnTheModelRound) {
