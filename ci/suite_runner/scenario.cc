@@ -16,6 +16,7 @@
 #include "common/logging.h"
 #include "common/paths.h"
 #include "sequence_format/manifest.h"
+#include "sim/motion/retarget.h"
 #include "tracker/pipeline/track_job.h"
 
 namespace irbench {
@@ -135,6 +136,14 @@ std::string CacheKey(const RenderJobOptions& r) {
                     "|" + std::to_string(r.seed) + "|" + std::to_string(r.frames.value_or(-1)) + "|" +
                     std::to_string(r.background_frames) + "|" + std::to_string(r.supersample) +
                     (SweepsScreens(r, in) ? "|sweep" : "");
+  // Motion capture is retargeted on load: its revision counts (for a session,
+  // when it names a capture file).
+  bool mocap = in.motion_kind == "bvh" || in.motion_kind == "amc";
+  if (in.motion_kind == "session" && fs::is_regular_file(in.motion_file)) {
+    const std::string text = ReadFileBytes(in.motion_file);
+    mocap = text.find(".bvh") != std::string::npos || text.find(".amc") != std::string::npos;
+  }
+  if (mocap) key += "|retarget " + std::to_string(kRetargetRevision);
   for (const fs::path& f : {in.rig_file, in.scene_file, in.avatar_file, in.motion_file}) {
     if (f.empty() || !fs::is_regular_file(f)) continue;
     key += ReadFileBytes(f);

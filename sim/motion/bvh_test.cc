@@ -4,9 +4,13 @@
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <optional>
+#include <utility>
 #include <random>
 
 #include "common/error.h"
@@ -252,6 +256,76 @@ TEST(BvhTest, ExportReimportRoundTrip) {
   fs::remove(file);
 }
 
+// The floor contacts of `motion` (in each half second, the lower ankle's
+// lowest point), split at the middle of the path they cover along its longest
+// direction: the lowest contact of each half, or nothing when the contacts
+// span less than `min_span` metres.
+std::optional<std::pair<double, double>> FloorAtPathEnds(const RetargetedMotion& motion, const Skeleton& skeleton,
+                                                         double min_span) {
+  std::vector<Eigen::Vector3d> contacts;
+  for (double t0 = 0; t0 + 0.5 <= motion.Duration(); t0 += 0.5) {
+    Eigen::Vector3d low(0, 0, std::numeric_limits<double>::infinity());
+    for (double t = t0; t < t0 + 0.5; t += motion.frame_time()) {
+      const JointTransforms fk = ForwardKinematics(skeleton, motion.At(t));
+      for (int ankle : {kRightAnkle, kLeftAnkle}) {
+        if (fk[ankle].translation().z() < low.z()) low = fk[ankle].translation();
+      }
+    }
+    contacts.push_back(low);
+  }
+  if (contacts.size() < 2) return std::nullopt;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& c : contacts) mean += c.head<2>() / contacts.size();
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const auto& c : contacts) cov += (c.head<2>() - mean) * (c.head<2>() - mean).transpose();
+  const Eigen::Vector2d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvectors().col(1);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& c : contacts) {
+    lo = std::min(lo, axis.dot(c.head<2>() - mean));
+    hi = std::max(hi, axis.dot(c.head<2>() - mean));
+  }
+  if (hi - lo < min_span) return std::nullopt;
+  std::pair<double, double> floor(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  for (const auto& c : contacts) {
+    double& half = axis.dot(c.head<2>() - mean) < (lo + hi) / 2 ? floor.first : floor.second;
+    half = std::min(half, c.z());
+  }
+  return floor;
+}
+
+// A capture whose floor leans (the whole clip turned 2.5 degrees about a
+// horizontal axis across the walk, its rest skeleton upright): retargeted, the
+// person walks on a level floor and moves as in the level capture. (A lean
+// about the walk's own line is barely seen by the feet of a straight walk, and
+// the levelling leaves most of it.)
+TEST(RetargetTest, LevelsACaptureWhoseFloorLeans) {
+  const Avatar avatar = Person("p2");
+  MotionContext ctx;
+  ctx.avatar = &avatar;
+  ctx.style = StyleFor("p2", 5);
+  const MotionPtr walk = BuildLibraryMotion("walk", {{"to", {0.0, 3.0}}}, ctx);
+  MocapClip level = BvhToClip(MotionToBvh(*walk, avatar.skeleton, 60));
+  level.convention = DetectConvention(level);
+  MocapClip leaning = level;
+  const Eigen::Quaterniond lean(Eigen::AngleAxisd(2.5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+  for (MocapClip::Frame& frame : leaning.frames) {
+    for (Eigen::Vector3d& p : frame.position) p = lean * p;
+    for (Eigen::Quaterniond& q : frame.rotation) q = lean * q;
+  }
+  const auto a = Retarget(level, avatar.skeleton), b = Retarget(leaning, avatar.skeleton);
+  const auto ends_a = FloorAtPathEnds(*a, avatar.skeleton, 2.0), ends_b = FloorAtPathEnds(*b, avatar.skeleton, 2.0);
+  ASSERT_TRUE(ends_a && ends_b);
+  EXPECT_NEAR(ends_a->first, ends_a->second, 0.005);
+  EXPECT_NEAR(ends_b->first, ends_b->second, 0.005);  // 13 cm apart without the levelling
+  double worst = 0;
+  for (double t = 0; t <= a->Duration(); t += 0.1) {
+    const JointTransforms fa = ForwardKinematics(avatar.skeleton, a->At(t));
+    const JointTransforms fb = ForwardKinematics(avatar.skeleton, b->At(t));
+    for (int j = 0; j < kJointCount; ++j) worst = std::max(worst, (fa[j].translation() - fb[j].translation()).norm());
+  }
+  EXPECT_LT(worst, 0.01);
+}
+
 // Every CMU clip beside the checkout: loads, retargets onto three persons, and
 // keeps the source's upper-arm and forearm directions.
 TEST(CmuClipsTest, RetargetKeepsArmDirections) {
@@ -288,7 +362,16 @@ TEST(CmuClipsTest, RetargetKeepsArmDirections) {
       }
       EXPECT_LT(worst, 2.0) << file.filename() << " on " << avatar.params.name;
       worst_all = std::max(worst_all, worst);
-      // The feet stay on the floor: the lowest ankle of the clip is at its bind height.
+      // Up is the file's +y (BVH's up) within the floor's lean (under 3 degrees).
+      EXPECT_GT((motion->world_from_source * Eigen::Vector3d::UnitY()).z(), std::cos(3 * M_PI / 180))
+          << file.filename();
+      // The floor is level: over a path of 2 m or more, the feet touch it as
+      // low in its first half as in its second.
+      if (const auto ends = FloorAtPathEnds(*motion, avatar.skeleton, 2.0)) {
+        std::printf("  %s on %s: floor at the path's ends %.3f %.3f m\n", file.stem().c_str(),
+                    avatar.params.name.c_str(), ends->first, ends->second);
+        EXPECT_NEAR(ends->first, ends->second, 0.015) << file.filename() << " on " << avatar.params.name;
+      }
       const JointTransforms fk0 = ForwardKinematics(avatar.skeleton, motion->At(0));
       EXPECT_GT(fk0[kHead].translation().z(), 0.6 * avatar.params.height_m) << file.filename();
     }

@@ -1,7 +1,11 @@
 #include "sim/motion/retarget.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
 
 #include "common/error.h"
 #include "common/logging.h"
@@ -36,19 +40,34 @@ double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   return a.angularDistance(b) * 180.0 / M_PI;
 }
 
-// Drops a synthetic first frame (see LoadMocap).
-void DropSyntheticFirstFrame(MocapClip& clip) {
-  if (clip.frames.size() < 4) return;
-  double d01 = 0, d12 = 0;
+// The largest turn of any joint from frame f to frame f + 1, in degrees.
+double StepDeg(const MocapClip& clip, size_t f) {
+  double step = 0;
   for (size_t j = 0; j < clip.joint_names.size(); ++j) {
-    d01 = std::max(d01, AngleDeg(clip.frames[0].rotation[j], clip.frames[1].rotation[j]));
-    d12 = std::max(d12, AngleDeg(clip.frames[1].rotation[j], clip.frames[2].rotation[j]));
+    step = std::max(step, AngleDeg(clip.frames[f].rotation[j], clip.frames[f + 1].rotation[j]));
   }
-  if (d01 > 10.0 && d01 > 5.0 * d12) {
-    Log().info("motion: {}: frame 0 jumps {:.0f}° to frame 1 (then {:.1f}°): a synthetic first "
-               "frame, dropped", clip.name, d01, d12);
-    clip.frames.erase(clip.frames.begin());
-  }
+  return step;
+}
+
+// Drops a synthetic start (see LoadMocap).
+void DropSyntheticStart(MocapClip& clip) {
+  if (clip.frames.size() < 4) return;
+  const double d01 = StepDeg(clip, 0), d12 = StepDeg(clip, 1);
+  std::vector<double> steps;
+  for (size_t f = 0; f + 1 < clip.frames.size(); ++f) steps.push_back(StepDeg(clip, f));
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double fast = std::max(5.0, 4.0 * steps[steps.size() / 2]);
+  size_t drop = d01 > 10.0 && d01 > 5.0 * d12 ? 1 : 0;
+  const size_t most = 1 + static_cast<size_t>(std::floor(0.1 / clip.frame_time));
+  while (drop < most && drop + 3 < clip.frames.size() && StepDeg(clip, drop) > fast) ++drop;
+  if (drop == 0) return;
+  Log().info("motion: {}: a synthetic start dropped: frame 0 turns some joint {:.0f}° to frame 1 (then {:.1f}°){}",
+             clip.name, d01, d12,
+             drop > 1 ? fmt::format(", and frames up to {} blend into the capture (over {:.1f}° per frame, "
+                                    "4x the clip's median)",
+                                    drop - 1, fast)
+                      : std::string());
+  clip.frames.erase(clip.frames.begin(), clip.frames.begin() + drop);
 }
 
 Eigen::Matrix3d FrameFrom(const Eigen::Vector3d& right, const Eigen::Vector3d& up) {
@@ -152,13 +171,22 @@ MocapClip LoadMocap(const std::filesystem::path& path, const std::filesystem::pa
                "using 1/120 s", clip.name);
     clip.frame_time = 1.0 / 120.0;
   }
-  DropSyntheticFirstFrame(clip);
+  DropSyntheticStart(clip);
   return clip;
 }
 
 Eigen::Matrix3d WorldFromSource(const MocapClip& clip, const Map& map) {
   auto rest = [&](const char* key) { return clip.rest_position[FindMapped(clip, map.at(key))]; };
-  const Eigen::Vector3d up = (rest("head") - rest("pelvis")).normalized();
+  // Up is the file's coordinate axis nearest the rest pose's pelvis-to-head
+  // line: a capture volume's axes are levelled to gravity, but a rest
+  // skeleton's spine leans (1-2 degrees forward in CMU's), and that lean taken
+  // as up tilts the floor, so a subject who walks 3 m rises or sinks 10 cm. A
+  // spine more than 20 degrees from every axis is taken as it is.
+  const Eigen::Vector3d spine = (rest("head") - rest("pelvis")).normalized();
+  Eigen::Index axis = 0;
+  spine.cwiseAbs().maxCoeff(&axis);
+  Eigen::Vector3d up = Eigen::Vector3d::Unit(axis) * (spine[axis] < 0 ? -1.0 : 1.0);
+  if (up.dot(spine) < std::cos(20 * M_PI / 180)) up = spine;
   Eigen::Vector3d left = rest("left_hip") - rest("right_hip");
   left = (left - up * up.dot(left)).normalized();
   const Eigen::Vector3d forward = left.cross(up);
@@ -183,6 +211,83 @@ Pose RetargetedMotion::At(double t) const {
   }
   return out;
 }
+
+namespace {
+
+// The rotation that levels the floor the clip's feet stand on, in the world
+// `r` puts the source in (scaled to metres by `scale`). A capture's floor can
+// lean a degree or two from its file's axes (CMU's walks rise or sink 2-6 cm
+// over 3 m); the feet say where it is. In each half second the lower ankle's
+// lowest point is a contact; a plane is fitted to the contacts by least squares,
+// leaving out those more than 2 cm above it (jumps, tiptoe) and refitting, and
+// kept level along a direction the contacts do not cover. Identity when there are fewer than 4 contacts or the plane
+// leans more than 5 degrees (then the floor is not what the feet show).
+Eigen::Matrix3d FloorTilt(const MocapClip& clip, const std::array<int, kJointCount>& src, const Eigen::Matrix3d& r,
+                          double scale) {
+  std::vector<Eigen::Vector3d> contacts;
+  const size_t window = std::max<size_t>(1, static_cast<size_t>(std::lround(0.5 / clip.frame_time)));
+  for (size_t start = 0; start + window <= clip.frames.size(); start += window) {
+    Eigen::Vector3d low(0, 0, std::numeric_limits<double>::infinity());
+    for (size_t f = start; f < start + window; ++f) {
+      for (int ankle : {kRightAnkle, kLeftAnkle}) {
+        const Eigen::Vector3d p = scale * (r * clip.frames[f].position[src[ankle]]);
+        if (p.z() < low.z()) low = p;
+      }
+    }
+    contacts.push_back(low);
+  }
+  if (contacts.size() < 4) return Eigen::Matrix3d::Identity();
+  // The plane z = c + g . (xy - mean), fitted along each principal direction
+  // of the contacts' spread that they cover (standard deviation 0.25 m or more)
+  // and level along one they do not.
+  Eigen::Vector2d slope = Eigen::Vector2d::Zero();
+  std::vector<bool> use(contacts.size(), true);
+  for (int pass = 0; pass < 4; ++pass) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double mean_z = 0;
+    int n = 0;
+    for (size_t i = 0; i < contacts.size(); ++i) {
+      if (!use[i]) continue;
+      mean += contacts[i].head<2>();
+      mean_z += contacts[i].z();
+      ++n;
+    }
+    if (n < 4) return Eigen::Matrix3d::Identity();
+    mean /= n;
+    mean_z /= n;
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (size_t i = 0; i < contacts.size(); ++i) {
+      if (use[i]) cov += (contacts[i].head<2>() - mean) * (contacts[i].head<2>() - mean).transpose() / n;
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    slope.setZero();
+    for (int k = 0; k < 2; ++k) {
+      if (eig.eigenvalues()(k) < 0.25 * 0.25) continue;
+      const Eigen::Vector2d dir = eig.eigenvectors().col(k);
+      double uz = 0;
+      for (size_t i = 0; i < contacts.size(); ++i) {
+        if (use[i]) uz += dir.dot(contacts[i].head<2>() - mean) * (contacts[i].z() - mean_z) / n;
+      }
+      slope += dir * (uz / eig.eigenvalues()(k));
+    }
+    for (size_t i = 0; i < contacts.size(); ++i) {
+      use[i] = contacts[i].z() - (mean_z + slope.dot(contacts[i].head<2>() - mean)) < 0.02;
+    }
+  }
+  const Eigen::Vector3d up = Eigen::Vector3d(-slope.x(), -slope.y(), 1).normalized();
+  if (up.z() < std::cos(5 * M_PI / 180)) {
+    Log().warn("motion: {}: the feet's floor leans {:.1f}° from the file's up; not levelled", clip.name,
+               std::acos(up.z()) * 180 / M_PI);
+    return Eigen::Matrix3d::Identity();
+  }
+  if (up.z() < std::cos(0.2 * M_PI / 180)) {
+    Log().info("motion: {}: the feet's floor leans {:.1f}° from the file's up; levelled", clip.name,
+               std::acos(up.z()) * 180 / M_PI);
+  }
+  return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+}  // namespace
 
 std::shared_ptr<RetargetedMotion> Retarget(const MocapClip& clip, const Skeleton& skeleton,
                                            const RetargetOptions& options) {
@@ -212,8 +317,7 @@ std::shared_ptr<RetargetedMotion> Retarget(const MocapClip& clip, const Skeleton
 
   const Eigen::Matrix3d heading =
       Eigen::AngleAxisd(options.heading_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d r = heading * WorldFromSource(clip, map);
-  const Eigen::Quaterniond rq(r);
+  const Eigen::Matrix3d unlevelled = heading * WorldFromSource(clip, map);
   const auto& bind = skeleton.bind_position;
   auto src_len = [&](int a, int b) { return (clip.rest_position[src[a]] - clip.rest_position[src[b]]).norm(); };
   const double src_leg = src_len(kRightHip, kRightKnee) + src_len(kRightKnee, kRightAnkle) +
@@ -223,6 +327,8 @@ std::shared_ptr<RetargetedMotion> Retarget(const MocapClip& clip, const Skeleton
                          (bind[kLeftHip] - bind[kLeftKnee]).norm() + (bind[kLeftKnee] - bind[kLeftAnkle]).norm();
   if (!(src_leg > 0)) throw InputError(file, "joints", "the legs have zero length in the rest pose");
   const double scale = our_leg / src_leg;
+  const Eigen::Matrix3d r = FloorTilt(clip, src, unlevelled, scale) * unlevelled;
+  const Eigen::Quaterniond rq(r);
 
   std::vector<Pose> poses(clip.frames.size());
   for (size_t f = 0; f < clip.frames.size(); ++f) {

@@ -17,12 +17,19 @@
 
 namespace irbench {
 
+// Bumped whenever Retarget or LoadMocap changes the motion a clip becomes, so
+// that suites' render caches (keyed on their inputs' bytes) render mocap
+// scenarios again. 2: the floor levelled and the converters' blend-in dropped.
+inline constexpr int kRetargetRevision = 2;
+
 // Loads a .bvh file, or an .amc file with its .asf (`asf` empty: the .asf
 // beside it named by the subject, "16_01.amc" -> "16.asf", or by the stem).
 // Fixes: raw amc2bvh files (CMU bone names) declaring 1/30 s per frame are
-// 120 Hz captures (frame time set to 1/120 s); a synthetic first frame (a
-// T-pose or rest frame added by converters, detected as a jump of more than
-// 10° that is 5x larger than the next frame's) is dropped.
+// 120 Hz captures (frame time set to 1/120 s); a synthetic start is dropped:
+// a first frame added by converters (a T-pose or rest frame, seen as a jump of
+// more than 10° that is 5x larger than the next frame's) and the blend into the
+// capture that some converters put after it (leading frames where some joint
+// turns more than 4x the clip's median turn per frame and 5°; at most 0.1 s).
 MocapClip LoadMocap(const std::filesystem::path& path, const std::filesystem::path& asf = {});
 
 // "mb", "daz", "3dsmax", "cmu", "irbench", or "" (unknown).
@@ -41,8 +48,9 @@ struct RetargetOptions {
   std::map<std::string, std::string> joint_map_overrides;
 };
 
-// The source's rest-pose frame turned into the world's: its up (pelvis to
-// head), left (right hip to left hip) and forward (left x up) go to +z, -x, +y.
+// The source's rest-pose frame turned into the world's: its up (the file's
+// axis nearest the pelvis-to-head line), left (right hip to left hip, levelled)
+// and forward (left x up) go to +z, -x, +y.
 Eigen::Matrix3d WorldFromSource(const MocapClip& clip, const std::map<std::string, std::string>& map);
 
 class RetargetedMotion : public MotionSource {
