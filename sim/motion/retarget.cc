@@ -220,8 +220,9 @@ namespace {
 // over 3 m); the feet say where it is. In each half second the lower ankle's
 // lowest point is a contact; a plane is fitted to the contacts by least squares,
 // leaving out those more than 2 cm above it (jumps, tiptoe) and refitting, and
-// kept level along a direction the contacts do not cover. Identity when there are fewer than 4 contacts or the plane
-// leans more than 5 degrees (then the floor is not what the feet show).
+// kept level along a direction the contacts do not cover. Identity when there
+// are fewer than 4 contacts or the plane leans more than 5 degrees (then the
+// floor is not what the feet show).
 Eigen::Matrix3d FloorTilt(const MocapClip& clip, const std::array<int, kJointCount>& src, const Eigen::Matrix3d& r,
                           double scale) {
   std::vector<Eigen::Vector3d> contacts;
