@@ -10,8 +10,8 @@
 #include <fstream>
 #include <limits>
 #include <optional>
-#include <utility>
 #include <random>
+#include <utility>
 
 #include "common/error.h"
 #include "sim/body/avatar.h"

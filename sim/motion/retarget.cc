@@ -52,14 +52,15 @@ double StepDeg(const MocapClip& clip, size_t f) {
 // Drops a synthetic start (see LoadMocap).
 void DropSyntheticStart(MocapClip& clip) {
   if (clip.frames.size() < 4) return;
-  const double d01 = StepDeg(clip, 0), d12 = StepDeg(clip, 1);
-  std::vector<double> steps;
+  std::vector<double> steps;  // steps[f]: frame f to f + 1
   for (size_t f = 0; f + 1 < clip.frames.size(); ++f) steps.push_back(StepDeg(clip, f));
-  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  const double fast = std::max(5.0, 4.0 * steps[steps.size() / 2]);
+  const double d01 = steps[0], d12 = steps[1];
+  std::vector<double> sorted = steps;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double fast = std::max(5.0, 4.0 * sorted[sorted.size() / 2]);
   size_t drop = d01 > 10.0 && d01 > 5.0 * d12 ? 1 : 0;
   const size_t most = 1 + static_cast<size_t>(std::floor(0.1 / clip.frame_time));
-  while (drop < most && drop + 3 < clip.frames.size() && StepDeg(clip, drop) > fast) ++drop;
+  while (drop < most && drop + 3 < clip.frames.size() && steps[drop] > fast) ++drop;
   if (drop == 0) return;
   Log().info("motion: {}: a synthetic start dropped: frame 0 turns some joint {:.0f}° to frame 1 (then {:.1f}°){}",
              clip.name, d01, d12,
