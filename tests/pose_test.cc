@@ -637,6 +637,32 @@ TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   EXPECT_EQ(FloorGap(EmptyStageHull(), model_root, height, options), 0.0);
 }
 
+// The top of the hull's column over the head: a head (a cylinder of 9 cm
+// radius up to 1.80 m) tops out at the upper face of its highest layer; a
+// hand 10 cm over it, apart, does not count, one laid on it does; nothing
+// where the layer it starts from is empty, or outside the grid.
+TEST(HullLegs, TheColumnOverTheHeadEndsAtTheFirstGap) {
+  VoxelHull hull = EmptyStageHull();
+  const Vector2d head(0.1, 0.2);
+  auto in_head = [&](const Vector3d& c) { return (c.head<2>() - head).norm() < 0.09 && c.z() > 1.5 && c.z() < 1.80; };
+  FillHull(&hull, in_head);
+  // Voxel centres below 1.80 m: the highest at 1.79, its upper face 1.80.
+  ASSERT_TRUE(HullColumnTop(hull, head, 1.65, 0.08));
+  EXPECT_NEAR(*HullColumnTop(hull, head, 1.65, 0.08), 1.80, 1e-9);
+  // Beside the head but within the radius of its edge: the same column.
+  EXPECT_NEAR(*HullColumnTop(hull, head + Vector2d(0.12, 0), 1.65, 0.08), 1.80, 1e-9);
+  VoxelHull hand = hull;
+  FillHull(&hand, [&](const Vector3d& c) { return (c.head<2>() - head).norm() < 0.05 && c.z() > 1.90 && c.z() < 2.0; });
+  EXPECT_NEAR(*HullColumnTop(hand, head, 1.65, 0.08), 1.80, 1e-9);
+  FillHull(&hand, [&](const Vector3d& c) { return (c.head<2>() - head).norm() < 0.05 && c.z() > 1.5 && c.z() < 2.0; });
+  EXPECT_NEAR(*HullColumnTop(hand, head, 1.65, 0.08), 2.0, 1e-9);
+  EXPECT_FALSE(HullColumnTop(hull, head + Vector2d(0.3, 0), 1.65, 0.08));
+  EXPECT_FALSE(HullColumnTop(hull, head, 1.2, 0.08));
+  EXPECT_FALSE(HullColumnTop(hull, head, -0.1, 0.08));
+  EXPECT_FALSE(HullColumnTop(hull, head, 2.5, 0.08));
+  EXPECT_FALSE(HullColumnTop(VoxelHull(), head, 1.65, 0.08));
+}
+
 // Two legs apart, one of them seen fatter (a calf seen by fewer views, a
 // ghost beside it): the layers' centres are the midpoints of the two legs,
 // as the truth's root is the midpoint of the ankles, not the voxels'
@@ -1279,6 +1305,54 @@ TEST(PoseTracker, FollowsAJumpWhereTheHullLeavesTheFloor) {
   const double capped = WaistErrorOverAJump(10.0, 1);
   EXPECT_GT(capped, 0.2);
   std::printf("jump with the waist held down: %.1f cm off\n", 100 * capped);
+}
+
+// A model rising 6 cm on tiptoe (frames 30-40) and staying up to frame 80:
+// the hull's feet stay on the floor (not a jump) and its column over the
+// head rises with the crown. The tracked waist's mean error over frames
+// 50-80.
+double WaistErrorOnTiptoe(double max_tiptoe_m, uint64_t seed) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  PoseTrackerOptions options;
+  options.seed = seed;
+  options.max_tiptoe_m = max_tiptoe_m;
+  PoseTracker tracker(cams, {}, options);
+  const Vector2d forward = Vector2d::UnitX(), side(0, -1);
+  const double ankle_z = options.hull_legs.ankle * shape.height_m;
+  double sum = 0;
+  int count = 0;
+  for (int f = 0; f < 80; ++f) {
+    const double lift = 0.06 * std::clamp((f - 30) / 10.0, 0.0, 1.0);
+    BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), YawFacing(forward));
+    truth.dof[kDofZ] += lift;
+    FrameFeatures seen = ModelFeatures(cams, shape, truth, f);
+    const PosedBody body = PoseBody(shape, truth);
+    seen.placement->top_m = shape.height_m + lift;
+    seen.voxels = LegsHull(body.joints[kModelRoot].head<2>(), side, forward, ankle_z, 0.0, 110);
+    const Vector2d head = body.joints[kModelHead].head<2>();
+    FillHull(&*seen.voxels, [&](const Vector3d& c) {
+      return (c.head<2>() - head).norm() < 0.09 && c.z() > 1.2 && c.z() < shape.height_m + lift;
+    });
+    const PoseEstimate e = tracker.Step(seen, 1.0 / 30);
+    if (f >= 50) {
+      sum += std::abs(e.pose.dof[kDofZ] - truth.dof[kDofZ]);
+      ++count;
+    }
+  }
+  return sum / count;
+}
+
+TEST(PoseTracker, RisesOnTiptoeWhereTheHullOverTheHeadDoes) {
+  for (uint64_t seed = 1; seed <= 2; ++seed) {
+    const double error = WaistErrorOnTiptoe(PoseTrackerOptions().max_tiptoe_m, seed);
+    EXPECT_LT(error, 0.015) << "seed " << seed;
+    std::printf("tiptoe, seed %d: the waist %.1f cm off on average\n", int(seed), 100 * error);
+  }
+  // Held to max_rise_m above its standing height (the rule off): 4 cm low.
+  const double capped = WaistErrorOnTiptoe(0.0, 1);
+  EXPECT_GT(capped, 0.03);
+  std::printf("tiptoe with the waist held down: %.1f cm off\n", 100 * capped);
 }
 
 TEST(PoseTracker, AStepBackIsNotAWalk) {

@@ -204,4 +204,31 @@ double FloorGap(const VoxelHull& hull, const Eigen::Vector3d& root, double heigh
   return gap;
 }
 
+std::optional<double> HullColumnTop(const VoxelHull& hull, const Eigen::Vector2d& xy, double from_z,
+                                    double radius_m) {
+  if (hull.voxel_size_m <= 0 || hull.nz <= 0) return std::nullopt;
+  const double size = hull.voxel_size_m;
+  const int z0 = static_cast<int>(std::floor((from_z - hull.origin_m.z()) / size));
+  if (z0 < 0 || z0 >= hull.nz) return std::nullopt;
+  const Eigen::Vector2d lo = (xy - Eigen::Vector2d::Constant(radius_m) - hull.origin_m.head<2>()) / size;
+  const Eigen::Vector2d hi = (xy + Eigen::Vector2d::Constant(radius_m) - hull.origin_m.head<2>()) / size;
+  const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())));
+  const int y0 = std::max(0, static_cast<int>(std::floor(lo.y())));
+  const int x1 = std::min(hull.nx, static_cast<int>(std::ceil(hi.x())));
+  const int y1 = std::min(hull.ny, static_cast<int>(std::ceil(hi.y())));
+  const double r2 = radius_m * radius_m;
+  auto layer_holds = [&](int z) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        if (hull.Occupied(x, y, z) && (hull.VoxelCenter(x, y, z).head<2>() - xy).squaredNorm() <= r2) return true;
+      }
+    }
+    return false;
+  };
+  if (!layer_holds(z0)) return std::nullopt;
+  int z = z0;
+  while (z + 1 < hull.nz && layer_holds(z + 1)) ++z;
+  return hull.origin_m.z() + (z + 1) * size;
+}
+
 }  // namespace irbench

@@ -106,4 +106,12 @@ bool FeetOnFloor(const VoxelHull& hull, const Eigen::Vector3d& root, double heig
 double FloorGap(const VoxelHull& hull, const Eigen::Vector3d& root, double height_m,
                 const HullLegsOptions& options = {});
 
+// The top of the hull's column over `xy`: the layers from the one holding
+// `from_z` upwards, each with an occupied voxel within radius_m of `xy`
+// (horizontally), without a gap; the upper face of the last. nullopt when
+// the layer at `from_z` holds none. A hand held over the head, apart from
+// it, does not count; one laid on it does.
+std::optional<double> HullColumnTop(const VoxelHull& hull, const Eigen::Vector2d& xy, double from_z,
+                                    double radius_m);
+
 }  // namespace irbench

@@ -338,7 +338,7 @@ BodyPose ProposeParticle(const BodyPose& current,
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
-  CapRise(context.shape, options.max_rise_m + context.floor_gap_m, &next);
+  CapRise(context.shape, options.max_rise_m + std::max(context.floor_gap_m, context.tiptoe_m), &next);
   return next;
 }
 
@@ -363,7 +363,7 @@ void RefineParticles(const BodyShape& shape,
                      std::mt19937_64& rng,
                      std::vector<BodyPose>* particles,
                      std::vector<double>* log_likelihood,
-                     double floor_gap_m) {
+                     double extra_rise_m) {
   std::vector<BodyPose>& proposed = *particles;
   const int n = static_cast<int>(proposed.size());
   const int refine = static_cast<int>(std::round(options.refine_fraction * n));
@@ -377,7 +377,7 @@ void RefineParticles(const BodyShape& shape,
     cv::parallel_for_(cv::Range(0, refine), [&](const cv::Range& r) {
       for (int j = r.start; j < r.end && !CancelRequested(); ++j) {
         refined[j] = RefineIcp(shape, proposed[order[j]], icp_views, options.icp);
-        CapRise(shape, options.max_rise_m + floor_gap_m, &refined[j]);
+        CapRise(shape, options.max_rise_m + extra_rise_m, &refined[j]);
         refined_ll[j] = score(refined[j]);
       }
     });

@@ -63,6 +63,10 @@ struct ProposalContext {
   // The waist may rise that much more than max_rise_m, and the body
   // position proposal lifts the waist by it.
   double floor_gap_m = 0;
+  // How far the hull's column over the head stands above the user's height
+  // (tiptoe; PoseTrackerOptions::max_tiptoe_m): the waist may rise that
+  // much more than max_rise_m (the larger of this and floor_gap_m).
+  double tiptoe_m = 0;
 };
 
 // A particle's log-likelihood: the observation (thesis 6.3.1) plus the
@@ -141,7 +145,7 @@ std::vector<double> WeighParticles(const std::vector<BodyPose>& particles, const
 
 // Thesis 6.3.3, refine-prediction: 2D-3D ICP (icp.h) on a random subset of
 // round(options.refine_fraction * n) particles; a refined particle (its rise
-// capped at max_rise_m + floor_gap_m) replaces its original, and its score
+// capped at max_rise_m + extra_rise_m) replaces its original, and its score
 // the original's, when it scores higher. Nothing without ICP iterations.
 void RefineParticles(const BodyShape& shape,
                      const std::vector<IcpView>& icp_views,
@@ -150,7 +154,7 @@ void RefineParticles(const BodyShape& shape,
                      std::mt19937_64& rng,
                      std::vector<BodyPose>* particles,
                      std::vector<double>* log_likelihood,
-                     double floor_gap_m = 0);
+                     double extra_rise_m = 0);
 
 // The index of the highest log-likelihood (the first of equals).
 int BestParticle(const std::vector<double>& log_likelihood);

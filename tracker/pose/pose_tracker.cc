@@ -320,7 +320,8 @@ std::vector<BodyPose> PoseTracker::ProposeParticles(const FrameFeatures& feature
                                   .entering = entering_,
                                   .lost = lost_,
                                   .posture = posture_,
-                                  .floor_gap_m = floor_gap_m_};
+                                  .floor_gap_m = floor_gap_m_,
+                                  .tiptoe_m = tiptoe_m_};
     for (size_t i = 0; i < particles_.size(); ++i) {
       proposed.push_back(ProposeParticle(particles_[i], previous_[i], dt, context, rng_));
     }
@@ -522,6 +523,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   if (!features.placement || features.cameras.size() != cameras_.size()) {
     active_ = false;
     last_yaw_.reset();
+    last_head_.reset();
     tracked_s_ = 0;
     lost_ = false;
     lifted_age_s_ = {kNever, kNever};
@@ -542,6 +544,14 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
     const double gap = FloorGap(*features.voxels, features.placement->root, shape_.height_m, options_.hull_legs);
     if (gap >= options_.min_floor_gap_m) floor_gap_m_ = gap;
   }
+  // On tiptoe: the hull's column over the last head stands above the
+  // user's height.
+  tiptoe_m_ = 0;
+  if (options_.max_tiptoe_m > 0 && features.voxels && last_head_ && InView(features.placement->root)) {
+    const std::optional<double> top =
+        HullColumnTop(*features.voxels, last_head_->head<2>(), last_head_->z(), options_.tiptoe_radius_m);
+    if (top) tiptoe_m_ = std::clamp(*top - shape_.height_m, 0.0, options_.max_tiptoe_m);
+  }
   std::vector<BodyPose> proposed = ProposeParticles(features, dt);
 
   // The particle filter (particle_filter.h): weights (thesis 6.3.1), then the
@@ -552,7 +562,8 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   std::vector<double> log_likelihood = WeighParticles(proposed, score);
   out.ms_observation = Millis(t_obs);
   const auto t_refine = std::chrono::steady_clock::now();
-  RefineParticles(shape_, icp_views, options_, score, rng_, &proposed, &log_likelihood, floor_gap_m_);
+  RefineParticles(shape_, icp_views, options_, score, rng_, &proposed, &log_likelihood,
+                  std::max(floor_gap_m_, tiptoe_m_));
   out.ms_refine = Millis(t_refine);
 
   const int best = BestParticle(log_likelihood);
@@ -566,6 +577,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   if (out.tracking && rest_ && !rest_->empty()) DecideRest(proposed, log_likelihood, best, views, dt, &out);
   MeasureLegs(features, dt, &out);
   HeadAndPointing(features, views, &out);
+  last_head_ = out.tracking ? std::optional<Eigen::Vector3d>(out.body.joints[kModelHead]) : std::nullopt;
 
   // Resampling (systematic), carrying each particle's previous state along
   // for the velocity.

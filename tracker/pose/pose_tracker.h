@@ -145,6 +145,11 @@ class PoseTracker {
   std::optional<PostureBands> posture_;
   // This frame's FloorGap of the hull (a jump), 0 on the floor.
   double floor_gap_m_ = 0;
+  // This frame's rise of the hull's column over the head above the user's
+  // height (PoseTrackerOptions::max_tiptoe_m), 0 when none.
+  double tiptoe_m_ = 0;
+  // The head centre of the last tracked estimate, while tracking goes on.
+  std::optional<Eigen::Vector3d> last_head_;
   std::shared_ptr<const RestClassifier> rest_;
   Eigen::Vector2d facing_xy_ = Eigen::Vector2d::UnitY();
   // The feet's direction (HullLegs::toes), averaged over feet_memory_s; zero

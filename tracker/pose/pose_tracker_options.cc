@@ -35,6 +35,8 @@ void PoseTrackerOptions::Check() const {
     throw InputError("", "pose.rest_max_log_overlap_loss", "must be non-negative");
   if (!(max_rise_m >= 0)) throw InputError("", "pose.max_rise_m", "must be non-negative");
   if (!(min_floor_gap_m > 0)) throw InputError("", "pose.min_floor_gap_m", "must be positive");
+  if (!(max_tiptoe_m >= 0)) throw InputError("", "pose.max_tiptoe_m", "must be non-negative");
+  if (!(tiptoe_radius_m > 0)) throw InputError("", "pose.tiptoe_radius_m", "must be positive");
   if (!(rest_seen_max_angle_deg >= 0 && rest_seen_max_angle_deg <= 180)) {
     throw InputError("", "pose.rest_seen_max_angle_deg", "must be in [0, 180]");
   }

@@ -69,6 +69,13 @@ struct PoseTrackerOptions {
   // the floor (a jump): then the waist may rise that much more, and the body
   // position proposal lifts it by that (FloorGap, ProposalContext).
   double min_floor_gap_m = 0.12;
+  // ... or the hull's column over the head (HullColumnTop, within
+  // tiptoe_radius_m of the head centre) stands above the user's measured
+  // height: on tiptoe the waist may rise as much more, up to max_tiptoe_m
+  // (0 turns it off). Not lifted by the proposal, as a jump is: the
+  // silhouettes say how far.
+  double max_tiptoe_m = 0.10;
+  double tiptoe_radius_m = 0.08;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
   IcpOptions icp;
