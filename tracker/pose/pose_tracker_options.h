@@ -73,8 +73,12 @@ struct PoseTrackerOptions {
   // tiptoe_radius_m of the head centre) stands above the user's measured
   // height: on tiptoe the waist may rise as much more, up to max_tiptoe_m
   // (0 turns it off). Not lifted by the proposal, as a jump is: the
-  // silhouettes say how far.
-  double max_tiptoe_m = 0.10;
+  // silhouettes say how far. Off by default: the measured height of a user
+  // who walks in reads low (p5's demo: 1.92 m from the first frames, the
+  // standing top 1.96), and the rule then lifts them all the time
+  // (docs/tracker.md: p5's pointing 1.77 -> 2.91 deg). 0.10 once the height
+  // is measured standing.
+  double max_tiptoe_m = 0.0;
   double tiptoe_radius_m = 0.08;
   // Refinement (thesis 6.3.3): the fraction of particles refined by 2D-3D ICP.
   double refine_fraction = 0.2;
