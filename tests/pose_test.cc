@@ -989,6 +989,59 @@ TEST(RestState, AForearmBentForwardUnderAHangingUpperArmIsNotForcedToRest) {
   ExpectEveryDecision(RestDecisions(options, truth, {true, true}), true, true);
 }
 
+// The mean distance (metres) over frames 5-19 between the tracked right
+// wrist and the truth's, for a tracker following a user whose right upper arm
+// hangs with the forearm held 95 deg forward (the hand before the belly, as
+// real motion holds it), the left arm hanging straight; the front end shows
+// neither arm, and the likelihood-ratio test passes any arm, so both are
+// forced down.
+double HeldForearmWristError(bool held_forearms, uint64_t seed) {
+  const std::vector<Camera> cams = PinholeRig();
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
+  for (int sh : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
+    truth.dof[sh] = 0.0;
+    truth.dof[sh + 1] = 0.1;
+    truth.dof[sh + 2] = 0.0;
+  }
+  truth.dof[kDofRightElbowAzimuth] = M_PI / 2;  // forward
+  truth.dof[kDofRightElbowZenith] = 95 * M_PI / 180;
+  truth.dof[kDofLeftElbowAzimuth] = truth.dof[kDofLeftElbowZenith] = 0.0;
+  const Vector3d wrist = PoseBody(shape, truth).joints[kModelRightWrist];
+  PoseTrackerOptions options;
+  options.seed = seed;
+  options.rest_max_log_overlap_loss = 1e9;
+  options.rest_held_forearms = held_forearms;
+  PoseTracker tracker(cams, {}, options);
+  tracker.set_rest_classifier(NeverRestSvm());
+  double sum = 0;
+  int n = 0;
+  for (int f = 0; f < 20; ++f) {
+    const PoseEstimate e = tracker.Step(ModelFeatures(cams, shape, truth, f, {false, false}), 1.0 / 30);
+    EXPECT_TRUE(e.tracking) << f;
+    if (f < 5) continue;
+    EXPECT_EQ(e.rest[0], std::optional<bool>(true)) << f;
+    sum += (e.body.joints[kModelRightWrist] - wrist).norm();
+    ++n;
+  }
+  return n > 0 ? sum / n : 1e9;
+}
+
+// An arm found at rest is forced to the best hanging pose; with the held
+// forearms among them (PoseTrackerOptions::rest_held_forearms) a forearm held
+// 95 deg forward keeps its wrist (2-3 cm off), where the rest test's poses
+// (forearms bent 63 deg at most) put it 10 cm off.
+TEST(RestState, AForcedDownArmKeepsAForearmHeldBeforeTheBody) {
+  for (uint64_t seed = 1; seed <= 2; ++seed) {
+    const double error = HeldForearmWristError(true, seed);
+    EXPECT_LT(error, 0.05) << "seed " << seed;
+    std::printf("held forearm, seed %d: the wrist %.1f cm off\n", int(seed), 100 * error);
+  }
+  const double without = HeldForearmWristError(false, 1);
+  EXPECT_GT(without, 0.08);
+  std::printf("held forearm forced to the rest test's poses: the wrist %.1f cm off\n", 100 * without);
+}
+
 TEST(RestState, OptionsAreChecked) {
   PoseTrackerOptions options;
   EXPECT_NO_THROW(options.Check());
@@ -996,6 +1049,9 @@ TEST(RestState, OptionsAreChecked) {
   EXPECT_THROW(options.Check(), InputError);
   options = PoseTrackerOptions();
   options.rest_lifted_memory_s = -1;
+  EXPECT_THROW(options.Check(), InputError);
+  options = PoseTrackerOptions();
+  options.rest_held_min_gain = std::nan("");
   EXPECT_THROW(options.Check(), InputError);
   options = PoseTrackerOptions();
   options.rest_lifted_angle_deg = options.rest_seen_max_angle_deg - 1;  // an arm seen at rest would count as lifted

@@ -398,8 +398,23 @@ bool PoseTracker::RestVote(const std::vector<std::optional<PosedBody>>& voters, 
   return rest_weight > 0.5 * total_weight;
 }
 
-BodyPose PoseTracker::HangingArmPose(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
-                                     double* ll) const {
+namespace {
+
+// The hanging arm's forearms (azimuth, zenith; PoseTrackerOptions::rest_held_forearms):
+// straight or bent forward, for the rest test ...
+constexpr std::pair<double, double> kHangingForearms[] = {{M_PI / 2, 0.0}, {M_PI / 2, 0.4}, {M_PI / 2, 0.8},
+                                                          {M_PI / 2, 1.1}};
+// ... and, once the arm is found at rest, held further forward, and forward
+// and across the belly.
+constexpr std::pair<double, double> kHeldForearms[] = {{M_PI / 2, 1.4},      {M_PI / 2, 1.7},
+                                                       {3 * M_PI / 4, 0.8}, {3 * M_PI / 4, 1.1},
+                                                       {3 * M_PI / 4, 1.4}, {3 * M_PI / 4, 1.7}};
+
+}  // namespace
+
+void PoseTracker::BestHangingArm(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
+                                 std::span<const std::pair<double, double>> forearms, BodyPose* down,
+                                 double* ll) const {
   // Forced down: the hanging pose the silhouettes like best, out to the
   // side, a little forward or back, the forearm straight or bent forward.
   // People seldom hang their arms dead straight; against a single
@@ -410,27 +425,23 @@ BodyPose PoseTracker::HangingArmPose(const BodyPose& pose, bool left, const std:
   // 7.7 -> 4.5 cm with these candidates; docs/tracker.md).
   const int sh = left ? kDofLeftShoulderAzimuth : kDofRightShoulderAzimuth;
   const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
-  BodyPose down = pose;
-  double down_ll = -std::numeric_limits<double>::infinity();
   static constexpr std::pair<double, double> kShoulders[] = {  // azimuth, zenith
       {0.0, 0.1}, {M_PI / 2, 0.15}, {M_PI / 2, 0.35}, {-M_PI / 2, 0.25}, {0.0, 0.35}};
   for (const auto& [shoulder_azimuth, shoulder_zenith] : kShoulders) {
-    for (const double elbow_zenith : {0.0, 0.4, 0.8, 1.1}) {
+    for (const auto& [elbow_azimuth, elbow_zenith] : forearms) {
       BodyPose candidate = pose;
       candidate.dof[sh] = shoulder_azimuth;
       candidate.dof[sh + 1] = shoulder_zenith;
       candidate.dof[sh + 2] = 0.0;
-      candidate.dof[el] = M_PI / 2;  // forward
+      candidate.dof[el] = elbow_azimuth;
       candidate.dof[el + 1] = elbow_zenith;
       const double candidate_ll = Evaluate(candidate, views, nullptr);
-      if (candidate_ll > down_ll) {
-        down_ll = candidate_ll;
-        down = candidate;
+      if (candidate_ll > *ll) {
+        *ll = candidate_ll;
+        *down = candidate;
       }
     }
   }
-  *ll = down_ll;
-  return down;
 }
 
 void PoseTracker::DecideRest(const std::vector<BodyPose>& proposed, const std::vector<double>& log_likelihood,
@@ -479,8 +490,9 @@ void PoseTracker::DecideRest(const std::vector<BodyPose>& proposed, const std::v
       out->rest[side] = false;
       continue;
     }
-    double down_ll = 0;
-    const BodyPose down = HangingArmPose(out->pose, left, views, &down_ll);
+    double down_ll = -std::numeric_limits<double>::infinity();
+    BodyPose down = out->pose;
+    BestHangingArm(out->pose, left, views, kHangingForearms, &down, &down_ll);
     if (!at_rest) {
       // The likelihood-ratio test against the estimate as it stands (the
       // other arm perhaps forced down).
@@ -489,6 +501,17 @@ void PoseTracker::DecideRest(const std::vector<BodyPose>& proposed, const std::v
     }
     out->rest[side] = at_rest;
     if (at_rest) {
+      if (options_.rest_held_forearms) {
+        // A held forearm must explain the silhouettes better by a margin.
+        const double margin = options_.rest_held_min_gain * options_.observation.sharpness;
+        BodyPose held = down;
+        double held_ll = down_ll + margin;
+        BestHangingArm(out->pose, left, views, kHeldForearms, &held, &held_ll);
+        if (held_ll > down_ll + margin) {
+          down = held;
+          down_ll = held_ll;
+        }
+      }
       out->pose = down;
       estimate_ll = down_ll;
     }

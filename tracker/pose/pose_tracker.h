@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "geometry/camera.h"
@@ -112,10 +113,12 @@ class PoseTracker {
   // The rest classifier's vote on one arm, by the voters' weights.
   bool RestVote(const std::vector<std::optional<PosedBody>>& voters, const std::vector<double>& vote_weight,
                 bool left) const;
-  // `pose` with one arm hanging as the silhouettes like best; its
-  // log-likelihood in `ll`.
-  BodyPose HangingArmPose(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
-                          double* ll) const;
+  // One arm of `pose` hanging (the upper arm at each of the hanging
+  // directions) with each of the forearms `forearms` ((azimuth, zenith) in
+  // the upper arm's frame): where the silhouettes like one better than the
+  // log-likelihood `ll`, it becomes `down` and its log-likelihood `ll`.
+  void BestHangingArm(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
+                      std::span<const std::pair<double, double>> forearms, BodyPose* down, double* ll) const;
   // The head from the hull (pointing.h) and the pointing rays of the arms
   // not at rest.
   void HeadAndPointing(const FrameFeatures& features, const std::vector<SilhouetteView>& views,

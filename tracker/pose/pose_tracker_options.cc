@@ -43,6 +43,8 @@ void PoseTrackerOptions::Check() const {
   if (!(rest_lifted_angle_deg >= 0 && rest_lifted_angle_deg <= 180)) {
     throw InputError("", "pose.rest_lifted_angle_deg", "must be in [0, 180]");
   }
+  if (!(rest_held_min_gain >= 0))
+    throw InputError("", "pose.rest_held_min_gain", "must be non-negative");
   if (!(rest_lifted_memory_s >= 0))
     throw InputError("", "pose.rest_lifted_memory_s", "must be non-negative");
   if (rest_lifted_angle_deg < rest_seen_max_angle_deg) {

@@ -100,7 +100,7 @@ struct PoseTrackerOptions {
   // motion, were forced down (docs/tracker.md).
   double rest_seen_max_angle_deg = 22.5;
   // An arm they do not show is at rest when forcing it down (to the best of
-  // six hanging poses, which the estimate then shows) costs less than this
+  // twenty hanging poses, which the estimate then shows) costs less than this
   // in the sum over cameras of log overlap ratio: the silhouettes cannot
   // tell that arm from a hanging one ("when the arms ... are wrapped near
   // the body, the silhouettes are visually nearly undistinguishable"). The
@@ -115,6 +115,18 @@ struct PoseTrackerOptions {
   // it cuts the arm-frames of a raised arm taken for hanging from 143 to 45.
   double rest_lifted_angle_deg = 45;
   double rest_lifted_memory_s = 0.5;
+  // An arm found at rest is forced down to the best hanging pose: the
+  // test's twenty and, with this, forearms held further forward (80 and 97
+  // deg) or forward and across the belly (46-97 deg). Real motion holds
+  // its hands before the body under hanging upper arms; forced to 63 deg
+  // at most, such a forearm put the wrist 15-40 cm off (docs/tracker.md).
+  // The rest decision itself (the likelihood-ratio test) keeps the twenty.
+  // A held forearm is taken only where it explains the silhouettes better
+  // by rest_held_min_gain (the units of rest_max_log_overlap_loss): with
+  // none, CMU 141_16's arms hanging 30 deg out took held forearms (arms
+  // +0.4 to +1.1 cm on its three persons; with 0.03 at most +0.2).
+  bool rest_held_forearms = true;
+  double rest_held_min_gain = 0.03;
   // The head joint, and so the pointing rays' origin, measured on the voxel
   // hull (HullHeadCentre) where every camera's silhouette holds the model's
   // head centre and the hull shows a head near it; the model's head
