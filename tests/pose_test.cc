@@ -965,18 +965,26 @@ TEST(RestState, AnArmSeenHangingIsAtRestAndOneSeenLiftedIsNot) {
 // a third of the CMU arm-frames wrongly at rest). The limit is half the
 // truth's forearm limit, 22.5 deg: such an arm is left to the SVM and the
 // filter, and a straight arm swung 20 deg is still at rest.
-TEST(RestState, AForearmBentForwardUnderAHangingUpperArmIsNotForcedToRest) {
-  const BodyShape shape = BodyShape::FromHeight(1.75);
+// A standing pose whose upper arms hang `shoulder_zenith` (radians) out to
+// the sides, the right forearm bent `right_elbow_zenith` forward, the left
+// arm straight.
+BodyPose RightForearmBentForward(const BodyShape& shape, double shoulder_zenith, double right_elbow_zenith) {
   BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
   for (int sh : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
     truth.dof[sh] = 0.0;
-    truth.dof[sh + 1] = 0.05;
+    truth.dof[sh + 1] = shoulder_zenith;
     truth.dof[sh + 2] = 0.0;
   }
   truth.dof[kDofRightElbowAzimuth] = M_PI / 2;  // forward
-  truth.dof[kDofRightElbowZenith] = 50 * M_PI / 180;
-  truth.dof[kDofLeftShoulderZenith] = 20 * M_PI / 180;  // the left arm straight, 20 deg out
+  truth.dof[kDofRightElbowZenith] = right_elbow_zenith;
   truth.dof[kDofLeftElbowAzimuth] = truth.dof[kDofLeftElbowZenith] = 0.0;
+  return truth;
+}
+
+TEST(RestState, AForearmBentForwardUnderAHangingUpperArmIsNotForcedToRest) {
+  const BodyShape shape = BodyShape::FromHeight(1.75);
+  BodyPose truth = RightForearmBentForward(shape, 0.05, 50 * M_PI / 180);
+  truth.dof[kDofLeftShoulderZenith] = 20 * M_PI / 180;  // the left arm straight, 20 deg out
   PoseTrackerOptions options;
   options.seed = 7;
   EXPECT_DOUBLE_EQ(options.rest_seen_max_angle_deg, 22.5);
@@ -998,15 +1006,7 @@ TEST(RestState, AForearmBentForwardUnderAHangingUpperArmIsNotForcedToRest) {
 double HeldForearmWristError(bool held_forearms, uint64_t seed) {
   const std::vector<Camera> cams = PinholeRig();
   const BodyShape shape = BodyShape::FromHeight(1.75);
-  BodyPose truth = StandingPose(shape, Vector2d(0.1, 0.2), 0.0);
-  for (int sh : {kDofRightShoulderAzimuth, kDofLeftShoulderAzimuth}) {
-    truth.dof[sh] = 0.0;
-    truth.dof[sh + 1] = 0.1;
-    truth.dof[sh + 2] = 0.0;
-  }
-  truth.dof[kDofRightElbowAzimuth] = M_PI / 2;  // forward
-  truth.dof[kDofRightElbowZenith] = 95 * M_PI / 180;
-  truth.dof[kDofLeftElbowAzimuth] = truth.dof[kDofLeftElbowZenith] = 0.0;
+  const BodyPose truth = RightForearmBentForward(shape, 0.1, 95 * M_PI / 180);
   const Vector3d wrist = PoseBody(shape, truth).joints[kModelRightWrist];
   PoseTrackerOptions options;
   options.seed = seed;
