@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "tracker/pose/internal/hull_column.h"
 
 namespace irbench {
 
@@ -210,24 +211,10 @@ std::optional<double> HullColumnTop(const VoxelHull& hull, const Eigen::Vector2d
   const double size = hull.voxel_size_m;
   const int z0 = static_cast<int>(std::floor((from_z - hull.origin_m.z()) / size));
   if (z0 < 0 || z0 >= hull.nz) return std::nullopt;
-  const Eigen::Vector2d lo = (xy - Eigen::Vector2d::Constant(radius_m) - hull.origin_m.head<2>()) / size;
-  const Eigen::Vector2d hi = (xy + Eigen::Vector2d::Constant(radius_m) - hull.origin_m.head<2>()) / size;
-  const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())));
-  const int y0 = std::max(0, static_cast<int>(std::floor(lo.y())));
-  const int x1 = std::min(hull.nx, static_cast<int>(std::ceil(hi.x())));
-  const int y1 = std::min(hull.ny, static_cast<int>(std::ceil(hi.y())));
-  const double r2 = radius_m * radius_m;
-  auto layer_holds = [&](int z) {
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        if (hull.Occupied(x, y, z) && (hull.VoxelCenter(x, y, z).head<2>() - xy).squaredNorm() <= r2) return true;
-      }
-    }
-    return false;
-  };
-  if (!layer_holds(z0)) return std::nullopt;
+  const pose_internal::HullColumn column(hull, xy, radius_m);
+  if (!column.LayerHolds(z0)) return std::nullopt;
   int z = z0;
-  while (z + 1 < hull.nz && layer_holds(z + 1)) ++z;
+  while (z + 1 < hull.nz && column.LayerHolds(z + 1)) ++z;
   return hull.origin_m.z() + (z + 1) * size;
 }
 

@@ -338,7 +338,7 @@ BodyPose ProposeParticle(const BodyPose& current,
     if (std::cos(next.dof[kDofYaw] - heading) < 0) next = FlippedPose(next);
   }
   ClampToJointLimits(&next);
-  CapRise(context.shape, options.max_rise_m + std::max(context.floor_gap_m, context.tiptoe_m), &next);
+  CapRise(context.shape, options.max_rise_m + context.extra_rise_m, &next);
   return next;
 }
 

@@ -63,10 +63,9 @@ struct ProposalContext {
   // The waist may rise that much more than max_rise_m, and the body
   // position proposal lifts the waist by it.
   double floor_gap_m = 0;
-  // How far the hull's column over the head stands above the user's height
-  // (tiptoe; PoseTrackerOptions::max_tiptoe_m): the waist may rise that
-  // much more than max_rise_m (the larger of this and floor_gap_m).
-  double tiptoe_m = 0;
+  // How much higher than max_rise_m the waist may rise: the larger of
+  // floor_gap_m and the tiptoe rise (PoseTracker::ExtraRise).
+  double extra_rise_m = 0;
 };
 
 // A particle's log-likelihood: the observation (thesis 6.3.1) plus the

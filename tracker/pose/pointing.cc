@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/error.h"
+#include "tracker/pose/internal/hull_column.h"
 
 namespace irbench {
 
@@ -46,30 +47,17 @@ std::optional<Eigen::Vector3d> HullHeadCentre(const VoxelHull& hull, const Eigen
   const double crown = model_head.z() + options.below_top * height_m;
   // The voxels that may hold the head: within radius_m of its centre across,
   // and from well below the crown to max_gap_m above it.
-  const Eigen::Vector3d lo = (Eigen::Vector3d(model_head.x() - options.radius_m, model_head.y() - options.radius_m,
-                                              crown - options.max_gap_m - options.slab * height_m) -
-                              hull.origin_m) / hull.voxel_size_m;
-  const Eigen::Vector3d hi = (Eigen::Vector3d(model_head.x() + options.radius_m, model_head.y() + options.radius_m,
-                                              crown + options.max_gap_m + hull.voxel_size_m) -
-                              hull.origin_m) / hull.voxel_size_m;
-  const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())));
-  const int y0 = std::max(0, static_cast<int>(std::floor(lo.y())));
-  const int z0 = std::max(0, static_cast<int>(std::floor(lo.z())));
-  const int x1 = std::min(hull.nx, static_cast<int>(std::ceil(hi.x())));
-  const int y1 = std::min(hull.ny, static_cast<int>(std::ceil(hi.y())));
-  const int z1 = std::min(hull.nz, static_cast<int>(std::ceil(hi.z())));
-  auto near = [&](int x, int y, int z) {
-    return hull.Occupied(x, y, z) &&
-           (hull.VoxelCenter(x, y, z).head<2>() - model_head.head<2>()).norm() <= options.radius_m;
-  };
+  const pose_internal::HullColumn column(hull, model_head.head<2>(), options.radius_m);
+  const int z0 = std::max(
+      0, static_cast<int>(std::floor(
+             (crown - options.max_gap_m - options.slab * height_m - hull.origin_m.z()) / hull.voxel_size_m)));
+  const int z1 = std::min(
+      hull.nz,
+      static_cast<int>(std::ceil((crown + options.max_gap_m + hull.voxel_size_m - hull.origin_m.z()) / hull.voxel_size_m)));
   // The top: the highest layer with a head voxel.
   int top = -1;
   for (int z = z1 - 1; z >= z0 && top < 0; --z) {
-    for (int y = y0; y < y1 && top < 0; ++y) {
-      for (int x = x0; x < x1 && top < 0; ++x) {
-        if (near(x, y, z)) top = z;
-      }
-    }
+    if (column.LayerHolds(z)) top = z;
   }
   if (top < 0) return std::nullopt;
   const double top_m = hull.origin_m.z() + (top + 1) * hull.voxel_size_m;  // the top layer's upper face
@@ -77,9 +65,9 @@ std::optional<Eigen::Vector3d> HullHeadCentre(const VoxelHull& hull, const Eigen
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   int count = 0;
   for (int z = top; z >= z0 && hull.VoxelCenter(0, 0, z).z() >= top_m - options.slab * height_m; --z) {
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        if (!near(x, y, z)) continue;
+    for (int y = column.y0; y < column.y1; ++y) {
+      for (int x = column.x0; x < column.x1; ++x) {
+        if (!column.Holds(x, y, z)) continue;
         sum += hull.VoxelCenter(x, y, z).head<2>();
         ++count;
       }

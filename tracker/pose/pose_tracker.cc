@@ -321,7 +321,7 @@ std::vector<BodyPose> PoseTracker::ProposeParticles(const FrameFeatures& feature
                                   .lost = lost_,
                                   .posture = posture_,
                                   .floor_gap_m = floor_gap_m_,
-                                  .tiptoe_m = tiptoe_m_};
+                                  .extra_rise_m = ExtraRise()};
     for (size_t i = 0; i < particles_.size(); ++i) {
       proposed.push_back(ProposeParticle(particles_[i], previous_[i], dt, context, rng_));
     }
@@ -400,19 +400,19 @@ bool PoseTracker::RestVote(const std::vector<std::optional<PosedBody>>& voters, 
 
 namespace {
 
-// The hanging arm's forearms (azimuth, zenith; PoseTrackerOptions::rest_held_forearms):
-// straight or bent forward, for the rest test ...
+// The hanging arm's forearms (elbow azimuth, zenith): straight or bent
+// forward, for the rest test and the arm forced down ...
 constexpr std::pair<double, double> kHangingForearms[] = {{M_PI / 2, 0.0}, {M_PI / 2, 0.4}, {M_PI / 2, 0.8},
                                                           {M_PI / 2, 1.1}};
 // ... and, once the arm is found at rest, held further forward, and forward
-// and across the belly.
+// and across the belly (PoseTrackerOptions::rest_held_forearms).
 constexpr std::pair<double, double> kHeldForearms[] = {{M_PI / 2, 1.4},      {M_PI / 2, 1.7},
                                                        {3 * M_PI / 4, 0.8}, {3 * M_PI / 4, 1.1},
                                                        {3 * M_PI / 4, 1.4}, {3 * M_PI / 4, 1.7}};
 
 }  // namespace
 
-void PoseTracker::BestHangingArm(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
+bool PoseTracker::BestHangingArm(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
                                  std::span<const std::pair<double, double>> forearms, BodyPose* down,
                                  double* ll) const {
   // Forced down: the hanging pose the silhouettes like best, out to the
@@ -427,6 +427,7 @@ void PoseTracker::BestHangingArm(const BodyPose& pose, bool left, const std::vec
   const int el = left ? kDofLeftElbowAzimuth : kDofRightElbowAzimuth;
   static constexpr std::pair<double, double> kShoulders[] = {  // azimuth, zenith
       {0.0, 0.1}, {M_PI / 2, 0.15}, {M_PI / 2, 0.35}, {-M_PI / 2, 0.25}, {0.0, 0.35}};
+  bool found = false;
   for (const auto& [shoulder_azimuth, shoulder_zenith] : kShoulders) {
     for (const auto& [elbow_azimuth, elbow_zenith] : forearms) {
       BodyPose candidate = pose;
@@ -439,9 +440,11 @@ void PoseTracker::BestHangingArm(const BodyPose& pose, bool left, const std::vec
       if (candidate_ll > *ll) {
         *ll = candidate_ll;
         *down = candidate;
+        found = true;
       }
     }
   }
+  return found;
 }
 
 void PoseTracker::DecideRest(const std::vector<BodyPose>& proposed, const std::vector<double>& log_likelihood,
@@ -503,14 +506,8 @@ void PoseTracker::DecideRest(const std::vector<BodyPose>& proposed, const std::v
     if (at_rest) {
       if (options_.rest_held_forearms) {
         // A held forearm must explain the silhouettes better by a margin.
-        const double margin = options_.rest_held_min_gain * options_.observation.sharpness;
-        BodyPose held = down;
-        double held_ll = down_ll + margin;
-        BestHangingArm(out->pose, left, views, kHeldForearms, &held, &held_ll);
-        if (held_ll > down_ll + margin) {
-          down = held;
-          down_ll = held_ll;
-        }
+        double held_ll = down_ll + options_.rest_held_min_gain * options_.observation.sharpness;
+        if (BestHangingArm(out->pose, left, views, kHeldForearms, &down, &held_ll)) down_ll = held_ll;
       }
       out->pose = down;
       estimate_ll = down_ll;
@@ -585,8 +582,7 @@ PoseEstimate PoseTracker::Step(const FrameFeatures& features, double dt) {
   std::vector<double> log_likelihood = WeighParticles(proposed, score);
   out.ms_observation = Millis(t_obs);
   const auto t_refine = std::chrono::steady_clock::now();
-  RefineParticles(shape_, icp_views, options_, score, rng_, &proposed, &log_likelihood,
-                  std::max(floor_gap_m_, tiptoe_m_));
+  RefineParticles(shape_, icp_views, options_, score, rng_, &proposed, &log_likelihood, ExtraRise());
   out.ms_refine = Millis(t_refine);
 
   const int best = BestParticle(log_likelihood);

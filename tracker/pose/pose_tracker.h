@@ -13,6 +13,7 @@
 // hull's placement), the calibration and the surveyed screens: never truth.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <memory>
@@ -116,8 +117,9 @@ class PoseTracker {
   // One arm of `pose` hanging (the upper arm at each of the hanging
   // directions) with each of the forearms `forearms` ((azimuth, zenith) in
   // the upper arm's frame): where the silhouettes like one better than the
-  // log-likelihood `ll`, it becomes `down` and its log-likelihood `ll`.
-  void BestHangingArm(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
+  // log-likelihood `ll`, it becomes `down` and its log-likelihood `ll`;
+  // true when one did.
+  bool BestHangingArm(const BodyPose& pose, bool left, const std::vector<SilhouetteView>& views,
                       std::span<const std::pair<double, double>> forearms, BodyPose* down, double* ll) const;
   // The head from the hull (pointing.h) and the pointing rays of the arms
   // not at rest.
@@ -151,6 +153,9 @@ class PoseTracker {
   // This frame's rise of the hull's column over the head above the user's
   // height (PoseTrackerOptions::max_tiptoe_m), 0 when none.
   double tiptoe_m_ = 0;
+  // How much higher than max_rise_m the waist may rise this frame: the
+  // larger of the two above.
+  double ExtraRise() const { return std::max(floor_gap_m_, tiptoe_m_); }
   // The head centre of the last tracked estimate, while tracking goes on.
   std::optional<Eigen::Vector3d> last_head_;
   std::shared_ptr<const RestClassifier> rest_;
