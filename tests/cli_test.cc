@@ -381,7 +381,7 @@ TEST(CliTest, TrackWritesFeaturesAndRefusesBadInput) {
   ASSERT_EQ(refined.exit_code, 0) << refined.err;
   const auto refined_meta = nlohmann::json::parse(ReadText(dir / "refined" / "track.json"));
   EXPECT_EQ(refined_meta["refine_fraction"], 0.5);
-  EXPECT_EQ(refined_meta["particles"], 100);
+  EXPECT_EQ(refined_meta["particles"], 200);
   EXPECT_EQ(refined_meta["stage"], "features");
   EXPECT_EQ(nlohmann::json::parse(ReadText(track / "track.json"))["refine_fraction"], 0.2);
   // ... and reaches shadow removal: on the thesis preset doubled thresholds
@@ -707,7 +707,7 @@ TEST(CliTest, SmokeSuitePassesAndCatchesADegradedTracker) {
   EXPECT_NE(bad.out.find("regressed from the baseline"), std::string::npos) << bad.out;
   EXPECT_NE(bad.err.find("suite smoke:"), std::string::npos) << bad.err;
 
-  // A degraded pose tracker (3 particles instead of 100), run two scenarios at
+  // A degraded pose tracker (3 particles instead of 200), run two scenarios at
   // a time: the arms regress.
   auto few_particles = nlohmann::json::parse(ReadText(smoke));
   for (auto& scenario : few_particles["scenarios"]) scenario["track"] = {{"particles", 3}};

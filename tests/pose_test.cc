@@ -759,6 +759,26 @@ TEST(PoseTracker, TheHeightIsMeasuredStandingUpStraight) {
   EXPECT_TRUE(calibration.MeasureHeightAndGirth(true, upright, 1.77, true, true, score, &model));
   EXPECT_NEAR(model.height_m, 1.77, 1e-9);
 
+  // A model started short (the user first seen half in view: 1.63 m for a
+  // 1.75 m user's top) stands with its waist too low for that top, which
+  // reads as a crouch and is not measured; the rise cap keeps the filter
+  // from lifting the waist there. Until measured, the model takes the top's
+  // height once it is more than height_top_match off (7 % here; at 10 %, as
+  // before 2026-12-07, p2 walking in stayed 1.48 m for 1.60 m for 80 frames).
+  BodyCalibration short_start(options);
+  BodyShape short_model = short_start.Start(1.63);
+  BodyPose short_standing = upright;
+  short_standing.dof[kDofZ] = short_model.waist_height_m;
+  ASSERT_GT(1.75 * short_model.waist_height_m / short_model.height_m * options.height_min_waist,
+            short_model.waist_height_m + options.max_rise_m);
+  EXPECT_FALSE(short_start.MeasureHeightAndGirth(true, short_standing, 1.75, true, true, score, &short_model));
+  const std::optional<double> ratio = short_start.MatchHullTop(1.75, &short_model);
+  ASSERT_TRUE(ratio);
+  EXPECT_NEAR(*ratio, 1.75 / 1.63, 1e-12);
+  EXPECT_NEAR(short_model.height_m, 1.75, 1e-9);
+  EXPECT_FALSE(short_start.MatchHullTop(1.70, &short_model));  // within 5 %: kept
+  EXPECT_TRUE(short_start.MatchHullTop(1.65, &short_model));
+
   // With a camera left out, the taller hull's tops stand in until the first
   // frame seen by all views, and are then forgotten (tops within 3 % of the
   // 1.75 m estimate's: its waist is high enough for them).

@@ -29,7 +29,7 @@ TEST(TrackSettingsTest, KeysAndFlagsAreUniqueAndDefaultsValid) {
   // track.json lists every setting with its default.
   const nlohmann::json j = SettingsJson(defaults);
   EXPECT_EQ(j.size(), TrackSettings().size());
-  EXPECT_EQ(j["particles"], 100);
+  EXPECT_EQ(j["particles"], 200);
   EXPECT_EQ(j["stage"], "pose");
   EXPECT_EQ(j["background_model"], "flicker");
   EXPECT_EQ(j["remove_shadows"], true);

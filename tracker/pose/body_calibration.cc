@@ -28,12 +28,13 @@ BodyShape BodyCalibration::Start(double top_m) {
 
 std::optional<double> BodyCalibration::MatchHullTop(double top_m, BodyShape* shape) const {
   // Until the height is measured (MeasureHeightAndGirth), a model more than
-  // 10 % off the hull's top takes the top's height: a user first seen half
-  // in view can give a low top, and a model left that small explains the
-  // silhouettes too poorly to be tracked and measured (tracker seed 3 on
-  // p2's demo stayed 1.2 m tall for the whole session).
+  // height_top_match off the hull's top takes the top's height: a user first
+  // seen half in view can give a low top, and a model left that small
+  // explains the silhouettes too poorly to be tracked and measured (tracker
+  // seed 3 on p2's demo stayed 1.2 m tall for the whole session; at 10 %, a
+  // model 7.5 % short was not measured for 80 frames: PoseTrackerOptions).
   const double height = std::clamp(top_m, 1.2, 2.2);
-  if (std::abs(height / shape->height_m - 1) > 0.1) {
+  if (std::abs(height / shape->height_m - 1) > options_.height_top_match) {
     const double ratio = height / shape->height_m;
     *shape = ShapeFor(height, shape->girth);
     return ratio;

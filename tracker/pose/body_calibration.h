@@ -65,8 +65,8 @@ class BodyCalibration {
     return static_cast<int>(heights_.size()) < options_.height_frames;
   }
 
-  // Until the height is measured, a model more than 10 % off the hull's top
-  // `top_m` (metres, clamped to 1.2-2.2) takes the top's height: updates
+  // Until the height is measured, a model more than height_top_match off the
+  // hull's top `top_m` (metres, clamped to 1.2-2.2) takes the top's height: updates
   // `shape` and returns the ratio of the new height to the old, by which the
   // particles' waist heights scale; nullopt when the model is kept.
   std::optional<double> MatchHullTop(double top_m, BodyShape* shape) const;

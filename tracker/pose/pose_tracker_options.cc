@@ -65,6 +65,7 @@ void PoseTrackerOptions::Check() const {
     throw InputError("", "pose.height_max_lean_deg", "must be in (0, 90]");
   if (!(height_min_waist >= 0 && height_min_waist <= 1))
     throw InputError("", "pose.height_min_waist", "must be in [0, 1]");
+  if (!(height_top_match > 0)) throw InputError("", "pose.height_top_match", "must be positive");
   if (arm_thickness_frames < 0)
     throw InputError("", "pose.arm_thickness_frames", "must be non-negative");
   if (arm_thickness_min_points < 1)
