@@ -18,7 +18,8 @@ struct PoseTrackerOptions {
   // 200, not 100 (docs/tracker.md "Particle count"): on the full suite's 48
   // CMU scenarios the arms' mean error fell from 10.86 / 11.10 cm to 9.50 /
   // 10.02 at filter seeds 1 / 2 (neck 5.47 / 5.80 -> 4.97 / 5.13 cm), the
-  // library scenarios' arms 2.82 -> 2.66, for about 7 ms more per frame-set.
+  // library scenarios' arms 2.82 -> 2.66, for 4-6 ms more per frame-set (irbench
+  // bench track on CMU 13_14, 2 cores: 7.1-7.6 -> 11.2-13.0 ms).
   int particles = 200;
   uint64_t seed = 1;
   ObservationOptions observation;
