@@ -44,7 +44,10 @@ std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& x_d) con
 }
 
 Eigen::Vector2d Camera::Project(const Eigen::Vector3d& p_in_world) const {
-  const Eigen::Vector3d p_in_cam = cam_from_world * p_in_world;
+  return ProjectInCamera(cam_from_world * p_in_world);
+}
+
+Eigen::Vector2d Camera::ProjectInCamera(const Eigen::Vector3d& p_in_cam) const {
   // cv::projectPoints: z = z ? 1/z : 1.
   const double inv_z = p_in_cam.z() != 0 ? 1.0 / p_in_cam.z() : 1.0;
   return DistortToPixel({p_in_cam.x() * inv_z, p_in_cam.y() * inv_z});

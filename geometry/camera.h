@@ -52,6 +52,9 @@ struct Camera {
   // Projects a world point to pixels, exactly as cv::projectPoints (including its
   // treatment of points at z = 0). Check z > 0 yourself for visibility.
   Eigen::Vector2d Project(const Eigen::Vector3d& p_in_world) const;
+  // The same for a point already in camera coordinates (cam_from_world * p):
+  // Project(p) == ProjectInCamera(cam_from_world * p), bit for bit.
+  Eigen::Vector2d ProjectInCamera(const Eigen::Vector3d& p_in_cam) const;
   // The unit ray direction in world coordinates through pixel `px`.
   std::optional<Eigen::Vector3d> PixelRayInWorld(const Eigen::Vector2d& px) const;
 

@@ -11,10 +11,37 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <utility>
 
 #include "common/error.h"
 
 namespace irbench {
+namespace {
+
+// The largest std::hypot(du[i], dv[i]) over i < n (0 for none; a NaN ignored
+// as std::max ignores it), with one hypot per near-largest pair instead of
+// one per pair (a voxel carver's set-up called it tens of millions of times).
+// hypot is within an ulp of the true length and the squared length within
+// three of its square, so a pair whose squared length lies a relative 1e-9
+// under the largest has a strictly smaller hypot than that pair: the result
+// is the same double as taking every hypot.
+template <typename Pair>
+double MaxHypot(size_t n, const Pair& pair) {
+  double max_sq = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const auto [du, dv] = pair(i);
+    max_sq = std::max(max_sq, du * du + dv * dv);
+  }
+  const double below = max_sq * (1 - 1e-9);
+  double result = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const auto [du, dv] = pair(i);
+    if (!(du * du + dv * dv < below)) result = std::max(result, std::hypot(du, dv));
+  }
+  return result;
+}
+
+}  // namespace
 
 void VoxelGridOptions::Check() const {
   if (!(voxel_size_m > 0)) throw InputError("", "voxels.voxel_size_m", "must be > 0");
@@ -194,9 +221,10 @@ void VoxelCarver::ComputeFootprints() {
         for (int x = 0; x < lx; ++x) {
           const size_t i = (size_t(z) * ly + y) * lx + x;
           const Eigen::Vector3d p = options_.min_corner_m + s * Eigen::Vector3d(x, y, z);
-          lok[i] = (cam.cam_from_world * p).z() > options_.near_m;
+          const Eigen::Vector3d p_in_cam = cam.cam_from_world * p;
+          lok[i] = p_in_cam.z() > options_.near_m;
           if (lok[i]) {
-            const Eigen::Vector2d px = cam.Project(p);
+            const Eigen::Vector2d px = cam.ProjectInCamera(p_in_cam);
             lu[i] = static_cast<float>(px.x());
             lv[i] = static_cast<float>(px.y());
           }
@@ -217,9 +245,9 @@ void VoxelCarver::ComputeFootprints() {
       }
       if (!ok) continue;  // partly behind the camera: no constraint
       const Eigen::Vector2d pc = cam.Project(VoxelCentre(v));
-      double corner_radius = 0;
-      for (size_t i : corner_index)
-        corner_radius = std::max(corner_radius, std::hypot(lu[i] - pc.x(), lv[i] - pc.y()));
+      const double corner_radius = MaxHypot(8, [&](size_t i) {
+        return std::pair<double, double>(lu[corner_index[i]] - pc.x(), lv[corner_index[i]] - pc.y());
+      });
       const double radius = options_.footprint_scale * corner_radius + m;
       // The disk partly outside the image: the camera cannot rule the voxel out.
       if (pc.x() - radius < -0.5 || pc.y() - radius < -0.5 || pc.x() + radius > w - 0.5 ||
@@ -270,12 +298,13 @@ VoxelCarver::BlockBound VoxelCarver::BoundOf(const Block& block, size_t c) const
   const double cu = 0.5 * (u_lo + u_hi), cv = 0.5 * (v_lo + v_hi);
   const int gu = std::clamp(static_cast<int>(std::lround(cu)), 0, w - 1),
             gv = std::clamp(static_cast<int>(std::lround(cv)), 0, h - 1);
-  double rho = 0;
-  for (uint32_t k = block.first; k < block.first + block.count; ++k) {
-    const Footprint& f = footprints_[size_t(k) * nc + c];
-    if (f.pixel < 0) continue;
-    rho = std::max(rho, std::hypot(f.pixel % w + f.frac_u / 256.0 - cu, f.pixel / w + f.frac_v / 256.0 - cv));
-  }
+  // Unconstrained voxels (pixel < 0) count as the centre itself.
+  const double rho = MaxHypot(block.count, [&](size_t i) {
+    const Footprint& f = footprints_[size_t(block.first + i) * nc + c];
+    return f.pixel < 0 ? std::pair<double, double>(0, 0)
+                       : std::pair<double, double>(f.pixel % w + f.frac_u / 256.0 - cu,
+                                                   f.pixel / w + f.frac_v / 256.0 - cv);
+  });
   const double reach = std::sqrt(2.0) + rho + std::hypot(cu - gu, cv - gv) + kSlackPx;
   // Voxels without a constraint pass, so only a fully constrained block
   // can be carved whole.
