@@ -208,62 +208,66 @@ void VoxelCarver::ComputeFootprints() {
   const size_t lattice = size_t(lx) * ly * lz;
   const size_t nc = cameras_.size();
   // Pass 2, per camera: the footprint of every candidate, from the projected
-  // lattice corners (each shared by up to 8 voxels).
+  // lattice corners (each shared by up to 8 voxels). The cameras run in
+  // parallel, each with its own projected lattice (9 bytes a lattice point)
+  // and writing only its own footprints: the same bytes on any thread count.
   const size_t nk = candidates_.size();
   footprints_.assign(nk * nc, Footprint{-1, 0, 0, 0});
-  std::vector<float> lu(lattice), lv(lattice);
-  std::vector<uint8_t> lok(lattice);
   const double m = options_.margin_px;
-  for (size_t c = 0; c < nc; ++c) {
-    const Camera& cam = cameras_[c];
-    for (int z = 0; z < lz; ++z) {
-      for (int y = 0; y < ly; ++y) {
-        for (int x = 0; x < lx; ++x) {
-          const size_t i = (size_t(z) * ly + y) * lx + x;
-          const Eigen::Vector3d p = options_.min_corner_m + s * Eigen::Vector3d(x, y, z);
-          const Eigen::Vector3d p_in_cam = cam.cam_from_world * p;
-          lok[i] = p_in_cam.z() > options_.near_m;
-          if (lok[i]) {
-            const Eigen::Vector2d px = cam.ProjectInCamera(p_in_cam);
-            lu[i] = static_cast<float>(px.x());
-            lv[i] = static_cast<float>(px.y());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(nc)), [&](const cv::Range& range) {
+    std::vector<float> lu(lattice), lv(lattice);
+    std::vector<uint8_t> lok(lattice);
+    for (size_t c = range.start; c < static_cast<size_t>(range.end); ++c) {
+      const Camera& cam = cameras_[c];
+      for (int z = 0; z < lz; ++z) {
+        for (int y = 0; y < ly; ++y) {
+          for (int x = 0; x < lx; ++x) {
+            const size_t i = (size_t(z) * ly + y) * lx + x;
+            const Eigen::Vector3d p = options_.min_corner_m + s * Eigen::Vector3d(x, y, z);
+            const Eigen::Vector3d p_in_cam = cam.cam_from_world * p;
+            lok[i] = p_in_cam.z() > options_.near_m;
+            if (lok[i]) {
+              const Eigen::Vector2d px = cam.ProjectInCamera(p_in_cam);
+              lu[i] = static_cast<float>(px.x());
+              lv[i] = static_cast<float>(px.y());
+            }
           }
         }
       }
-    }
-    const int w = cam.width, h = cam.height;
-    for (size_t k = 0; k < nk; ++k) {
-      const size_t v = candidates_[k];
-      const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
-                z = static_cast<int>(v / nx_ / ny_);
-      size_t corner_index[8];
-      bool ok = true;
-      for (int corner = 0; corner < 8; ++corner) {
-        corner_index[corner] =
-            (size_t(z + (corner >> 2)) * ly + y + ((corner >> 1) & 1)) * lx + x + (corner & 1);
-        ok = ok && lok[corner_index[corner]];
+      const int w = cam.width, h = cam.height;
+      for (size_t k = 0; k < nk; ++k) {
+        const size_t v = candidates_[k];
+        const int x = static_cast<int>(v % nx_), y = static_cast<int>((v / nx_) % ny_),
+                  z = static_cast<int>(v / nx_ / ny_);
+        size_t corner_index[8];
+        bool ok = true;
+        for (int corner = 0; corner < 8; ++corner) {
+          corner_index[corner] =
+              (size_t(z + (corner >> 2)) * ly + y + ((corner >> 1) & 1)) * lx + x + (corner & 1);
+          ok = ok && lok[corner_index[corner]];
+        }
+        if (!ok) continue;  // partly behind the camera: no constraint
+        const Eigen::Vector2d pc = cam.Project(VoxelCentre(v));
+        const double corner_radius = MaxHypot(8, [&](size_t i) {
+          return std::pair<double, double>(lu[corner_index[i]] - pc.x(), lv[corner_index[i]] - pc.y());
+        });
+        const double radius = options_.footprint_scale * corner_radius + m;
+        // The disk partly outside the image: the camera cannot rule the voxel out.
+        if (pc.x() - radius < -0.5 || pc.y() - radius < -0.5 || pc.x() + radius > w - 0.5 ||
+            pc.y() + radius > h - 0.5) {
+          continue;
+        }
+        // Bilinear interpolation reads the pixel right of and below the floor.
+        const double fu = std::clamp(pc.x(), 0.0, w - 1.001), fv = std::clamp(pc.y(), 0.0, h - 1.001);
+        const int u0 = static_cast<int>(fu), v0 = static_cast<int>(fv);
+        Footprint& f = footprints_[k * nc + c];
+        f.pixel = v0 * w + u0;
+        f.frac_u = static_cast<uint8_t>(std::min(255.0, std::round((fu - u0) * 256)));
+        f.frac_v = static_cast<uint8_t>(std::min(255.0, std::round((fv - v0) * 256)));
+        f.radius_q = static_cast<uint16_t>(std::min(65535.0, std::floor(radius * 64)));
       }
-      if (!ok) continue;  // partly behind the camera: no constraint
-      const Eigen::Vector2d pc = cam.Project(VoxelCentre(v));
-      const double corner_radius = MaxHypot(8, [&](size_t i) {
-        return std::pair<double, double>(lu[corner_index[i]] - pc.x(), lv[corner_index[i]] - pc.y());
-      });
-      const double radius = options_.footprint_scale * corner_radius + m;
-      // The disk partly outside the image: the camera cannot rule the voxel out.
-      if (pc.x() - radius < -0.5 || pc.y() - radius < -0.5 || pc.x() + radius > w - 0.5 ||
-          pc.y() + radius > h - 0.5) {
-        continue;
-      }
-      // Bilinear interpolation reads the pixel right of and below the floor.
-      const double fu = std::clamp(pc.x(), 0.0, w - 1.001), fv = std::clamp(pc.y(), 0.0, h - 1.001);
-      const int u0 = static_cast<int>(fu), v0 = static_cast<int>(fv);
-      Footprint& f = footprints_[k * nc + c];
-      f.pixel = v0 * w + u0;
-      f.frac_u = static_cast<uint8_t>(std::min(255.0, std::round((fu - u0) * 256)));
-      f.frac_v = static_cast<uint8_t>(std::min(255.0, std::round((fv - v0) * 256)));
-      f.radius_q = static_cast<uint16_t>(std::min(65535.0, std::floor(radius * 64)));
     }
-  }
+  });
 }
 
 // Per block and camera: the bounds. Each voxel's test value is the bilinear
@@ -314,18 +318,18 @@ VoxelCarver::BlockBound VoxelCarver::BoundOf(const Block& block, size_t c) const
 
 void VoxelCarver::ComputeBounds() {
   const size_t nc = cameras_.size();
-  bounds_.resize(blocks_.size() * nc);
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    for (size_t c = 0; c < nc; ++c) bounds_[b * nc + c] = BoundOf(blocks_[b], c);
-  }
-  sub_bounds_.resize(sub_blocks_.size() * nc);
-  for (size_t b = 0; b < sub_blocks_.size(); ++b) {
-    for (size_t c = 0; c < nc; ++c) sub_bounds_[b * nc + c] = BoundOf(sub_blocks_[b], c);
-  }
-  cell_bounds_.resize(cells_.size() * nc);
-  for (size_t b = 0; b < cells_.size(); ++b) {
-    for (size_t c = 0; c < nc; ++c) cell_bounds_[b * nc + c] = BoundOf(cells_[b], c);
-  }
+  // Each level's blocks in parallel (every bound is written once).
+  const auto bound_all = [&](const std::vector<Block>& blocks, std::vector<BlockBound>* bounds) {
+    bounds->resize(blocks.size() * nc);
+    cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
+      for (int b = range.start; b < range.end; ++b) {
+        for (size_t c = 0; c < nc; ++c) (*bounds)[b * nc + c] = BoundOf(blocks[b], c);
+      }
+    });
+  };
+  bound_all(blocks_, &bounds_);
+  bound_all(sub_blocks_, &sub_bounds_);
+  bound_all(cells_, &cell_bounds_);
 }
 
 cv::Mat DistanceToSilhouette(const cv::Mat& silhouette) {
