@@ -796,7 +796,7 @@ Visibility Renderer::PointVisibility(int index,
   const Target& t = *targets_.at(index);
   const Eigen::Vector3d p_in_cam = cam.cam_from_world * p_in_world;
   if (p_in_cam.z() <= options_.near_m) return kOutside;
-  const Eigen::Vector2d px = cam.Project(p_in_world);
+  const Eigen::Vector2d px = cam.ProjectInCamera(p_in_cam);
   if (px.x() < 0 || px.y() < 0 || px.x() > cam.width - 1 || px.y() > cam.height - 1) return kOutside;
   const Camera& rc = t.render_camera;
   const double qx = rc.fx * p_in_cam.x() / p_in_cam.z() + rc.cx;

@@ -110,8 +110,9 @@ std::optional<BodyPlacement> PlaceBodyWithoutOneView(const VoxelCarver& carver, 
     const Camera& cam = carver.cameras()[c];
     int seen = 0, inside = 0;
     for (const Eigen::Vector3d& v : hull.OccupiedCenters()) {
-      if ((cam.cam_from_world * v).z() <= carver.options().near_m) continue;
-      const Eigen::Vector2d px = cam.Project(v);
+      const Eigen::Vector3d v_in_cam = cam.cam_from_world * v;
+      if (v_in_cam.z() <= carver.options().near_m) continue;
+      const Eigen::Vector2d px = cam.ProjectInCamera(v_in_cam);
       const int u = static_cast<int>(std::lround(px.x())), w = static_cast<int>(std::lround(px.y()));
       if (u < 0 || w < 0 || u >= silhouettes[c].cols || w >= silhouettes[c].rows) continue;
       ++seen;

@@ -144,8 +144,9 @@ std::vector<uint8_t> VoxelCarver::CountObservingCameras() const {
     }
     for (size_t v = 0; v < voxels; ++v) {
       const Eigen::Vector3d centre = VoxelCentre(v);
-      if ((cam.cam_from_world * centre).z() <= options_.near_m) continue;
-      const Eigen::Vector2d pc = cam.Project(centre);
+      const Eigen::Vector3d centre_in_cam = cam.cam_from_world * centre;
+      if (centre_in_cam.z() <= options_.near_m) continue;
+      const Eigen::Vector2d pc = cam.ProjectInCamera(centre_in_cam);
       if (pc.x() >= -0.5 && pc.y() >= -0.5 && pc.x() <= cam.width - 0.5 &&
           pc.y() <= cam.height - 0.5)
         ++observed[v];

@@ -80,7 +80,7 @@ cv::Mat Overlay(const cv::Mat& frame, const CameraFeatures& f, const AxisView* v
     for (const AxisPoint3d& a : axis3d) {
       const Eigen::Vector3d p_in_cam = view->camera.cam_from_world * a.p_in_world;
       if (p_in_cam.z() <= 0) continue;
-      const Eigen::Vector2d px = view->camera.Project(a.p_in_world);
+      const Eigen::Vector2d px = view->camera.ProjectInCamera(p_in_cam);
       if (!px.allFinite() || px.cwiseAbs().maxCoeff() > 1e5) continue;
       cv::drawMarker(out, cv::Point(int(std::lround(px.x())), int(std::lround(px.y()))), {255, 255, 255},
                      cv::MARKER_CROSS, 3, 1);

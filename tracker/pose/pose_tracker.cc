@@ -74,8 +74,9 @@ bool HoldsBox(const Camera& cam, const Eigen::Vector3d& root, double height_m, d
     for (double dx : {-margin_m, margin_m}) {
       for (double dy : {-margin_m, margin_m}) {
         const Vector3d p(root.x() + dx, root.y() + dy, z);
-        if ((cam.cam_from_world * p).z() <= 0.05) return false;
-        const Eigen::Vector2d px = cam.Project(p);
+        const Vector3d p_in_cam = cam.cam_from_world * p;
+        if (p_in_cam.z() <= 0.05) return false;
+        const Eigen::Vector2d px = cam.ProjectInCamera(p_in_cam);
         if (!(px.x() >= 0 && px.y() >= 0 && px.x() <= cam.width - 1 && px.y() <= cam.height - 1)) return false;
       }
     }
