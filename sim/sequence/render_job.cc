@@ -400,9 +400,14 @@ std::string RenderBackground(RenderRun& run,
   for (const std::string& line : kept) background_lines += line;
   const ResumeFrom from = ResumeFromKept(kept, in);
   run.renderer.SetPersonVisible(false);
+  // The empty stage looks the same in every frame-set until the sensor sees
+  // it (the screens' content, flicker, sweep and noise are the exposure's):
+  // rendered once, exposed once per frame-set.
+  bool rendered = false;
   for (int f = from.kept < count ? from.first : count; f < count; ++f) {
     ThrowIfCancelled();
-    run.renderer.RenderAll(&run.all_images, run.need_depth);
+    if (!rendered) run.renderer.RenderAll(&run.all_images, run.need_depth);
+    rendered = true;
     const double t = f / in.fps - background_s;
     nlohmann::json sensor_truth = nlohmann::json::object();
     const double sweep = sweep_screens ? ScreenSweepLevel(f, count) : -1.0;
