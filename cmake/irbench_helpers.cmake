@@ -43,7 +43,9 @@ function(irbench_test name)
   target_compile_definitions(${name} PRIVATE
     IRBENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     IRBENCH_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  set(properties LABELS "${ARG_LABELS}")
+  # Every test's derived-data cache (the bounce light's volumes: common/paths.h
+  # UserCacheDir) in the build folder, not the user's.
+  set(properties LABELS "${ARG_LABELS}" ENVIRONMENT "IRBENCH_CACHE_DIR=${PROJECT_BINARY_DIR}/test-cache")
   if(ARG_COST)
     list(APPEND properties COST ${ARG_COST})
   endif()

@@ -62,4 +62,16 @@ fs::path ResolveDataFile(const std::string& kind,
 
 std::string ToolVersion() { return IRBENCH_VERSION; }
 
+fs::path UserCacheDir() {
+  if (const char* env = std::getenv("IRBENCH_CACHE_DIR"); env != nullptr) {
+    const std::string dir(env);
+    return dir.empty() || dir == "off" ? fs::path() : fs::path(dir);
+  }
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg == '/') return fs::path(xdg) / "irbench";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home == '/') {
+    return fs::path(home) / ".cache" / "irbench";
+  }
+  return {};
+}
+
 }  // namespace irbench

@@ -30,4 +30,10 @@ std::filesystem::path ResolveDataFile(const std::string& kind,
 
 std::string ToolVersion();
 
+// The folder for caches of derived data that any run may rebuild (the bounce
+// light's volumes, docs/sensor.md): $IRBENCH_CACHE_DIR when set (empty or
+// "off": no cache), else $XDG_CACHE_HOME/irbench, else $HOME/.cache/irbench.
+// Empty when there is none. Not created here.
+std::filesystem::path UserCacheDir();
+
 }  // namespace irbench

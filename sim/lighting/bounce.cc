@@ -1,11 +1,20 @@
 #include "sim/lighting/bounce.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
+
+#include "common/atomic_file.h"
+#include "common/logging.h"
+#include "common/paths.h"
+#include "common/sha256.h"
 
 namespace irbench {
 namespace {
@@ -267,12 +276,153 @@ IrradianceVolume ComputeBounceVolume(const TriangleMesh& mesh,
 
 }  // namespace
 
+namespace {
+
+// The disk cache (bounce.h). This build of this file: its compile time and
+// compiler. A volume is read only by the build that computed it, so a change
+// to the arithmetic here (or to the inputs' meaning in the headers this file
+// includes) never meets a volume computed the old way.
+constexpr char kBuildStamp[] = __DATE__ " " __TIME__ " " __VERSION__;
+constexpr char kMagic[8] = {'I', 'R', 'B', 'O', 'U', 'N', 'C', '1'};
+// Files not written for this long are removed when another is written.
+constexpr auto kUnusedFor = std::chrono::hours(24 * 30);
+
+template <typename T>
+void Put(std::string& out, const T& value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+// Everything the volume is computed from, and this build.
+std::string CacheKey(const TriangleMesh& mesh, const std::vector<IrLight>& lights, const BounceOptions& options) {
+  std::string bytes(kBuildStamp, sizeof(kBuildStamp));
+  Put(bytes, options.patch_m);
+  Put(bytes, options.grid_m);
+  Put(bytes, options.bounces);
+  Put(bytes, lights.size());
+  for (const IrLight& l : lights) {
+    for (int k = 0; k < 3; ++k) Put(bytes, l.position[k]);
+    for (int k = 0; k < 3; ++k) Put(bytes, l.direction[k]);
+    Put(bytes, l.cone_deg);
+    Put(bytes, l.power);
+    Put(bytes, l.wavelength_nm);
+  }
+  Put(bytes, mesh.vertices.size());
+  bytes.append(reinterpret_cast<const char*>(mesh.vertices.data()), mesh.vertices.size() * sizeof(MeshVertex));
+  Put(bytes, mesh.indices.size());
+  bytes.append(reinterpret_cast<const char*>(mesh.indices.data()), mesh.indices.size() * sizeof(uint32_t));
+  return Sha256OfBytes(bytes);
+}
+
+std::string Serialise(const std::string& key, const IrradianceVolume& v) {
+  std::string out(kMagic, sizeof(kMagic));
+  out += key;
+  for (int k = 0; k < 3; ++k) Put(out, v.origin[k]);
+  Put(out, v.spacing);
+  for (int k = 0; k < 3; ++k) Put(out, int32_t(v.dims[k]));
+  Put(out, uint64_t(v.values.size()));
+  for (const Eigen::Vector3f& e : v.values) {
+    for (int c = 0; c < 3; ++c) Put(out, e[c]);
+  }
+  return out;
+}
+
+// The volume in `bytes` when they are a whole cache file for `key`.
+std::optional<IrradianceVolume> Deserialise(const std::string& key, const std::string& bytes) {
+  size_t at = 0;
+  auto take = [&](void* value, size_t n) {
+    if (bytes.size() - at < n) return false;
+    std::memcpy(value, bytes.data() + at, n);
+    at += n;
+    return true;
+  };
+  char magic[sizeof(kMagic)];
+  std::string stored(key.size(), '\0');
+  if (!take(magic, sizeof(magic)) || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) return std::nullopt;
+  if (!take(stored.data(), stored.size()) || stored != key) return std::nullopt;
+  IrradianceVolume v;
+  int32_t dims[3];
+  uint64_t count = 0;
+  if (!take(v.origin.data(), 3 * sizeof(double)) || !take(&v.spacing, sizeof(double)) || !take(dims, sizeof(dims)) ||
+      !take(&count, sizeof(count))) {
+    return std::nullopt;
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (dims[k] < 0) return std::nullopt;
+    v.dims[k] = dims[k];
+  }
+  if (count != 6 * uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2])) return std::nullopt;
+  if (bytes.size() - at != count * 3 * sizeof(float)) return std::nullopt;
+  v.values.resize(count);
+  for (Eigen::Vector3f& e : v.values) take(e.data(), 3 * sizeof(float));
+  return v;
+}
+
+std::filesystem::path CacheFolder() {
+  const std::filesystem::path root = UserCacheDir();
+  return root.empty() ? root : root / "bounce";
+}
+
+std::optional<IrradianceVolume> ReadCached(const std::filesystem::path& file, const std::string& key) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::optional<IrradianceVolume> v = Deserialise(key, bytes);
+  if (!v) Log().warn("bounce light: ignoring the damaged cache file {} (computing it again)", file.string());
+  return v;
+}
+
+// Writes the volume's file (a file that cannot be written is only a cache
+// miss next time) and removes files of the folder not written for a month
+// (killed writers' temporaries after a day).
+void WriteCached(const std::filesystem::path& file, const std::string& key, const IrradianceVolume& volume) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(file.parent_path(), ec);
+  try {
+    AtomicWriteFile(file, Serialise(key, volume));
+  } catch (const std::exception& e) {
+    Log().debug("bounce light: not cached: {}", e.what());
+    return;
+  }
+  const auto now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(file.parent_path(), ec), end; !ec && it != end; it.increment(ec)) {
+    // Volumes, and the temporaries of writers that were killed.
+    const fs::path p = it->path();
+    const std::string name = p.filename().string();
+    const bool temporary = name.starts_with(".") && name.find(".bin.tmp-") != std::string::npos;
+    if ((p.extension() != ".bin" && !temporary) || p == file) continue;
+    std::error_code time_ec;
+    const auto written = fs::last_write_time(p, time_ec);
+    if (!time_ec && now - written > (temporary ? std::chrono::hours(24) : kUnusedFor)) fs::remove(p, time_ec);
+  }
+}
+
+}  // namespace
+
+std::filesystem::path BounceCacheFile(const TriangleMesh& mesh,
+                                      const std::vector<IrLight>& lights,
+                                      const BounceOptions& options) {
+  const std::filesystem::path folder = CacheFolder();
+  return folder.empty() ? folder : folder / (CacheKey(mesh, lights, options) + ".bin");
+}
+
 IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
                                const std::vector<IrLight>& lights,
                                const BounceOptions& options) {
   if (std::optional<IrradianceVolume> kept = LastBounceVolume().Find(mesh, lights, options)) return *std::move(kept);
+  const std::filesystem::path folder = CacheFolder();
+  const std::string key = folder.empty() ? std::string() : CacheKey(mesh, lights, options);
+  const std::filesystem::path file = folder.empty() ? folder : folder / (key + ".bin");
+  if (!file.empty()) {
+    if (std::optional<IrradianceVolume> cached = ReadCached(file, key)) {
+      Log().debug("bounce light: read from {}", file.string());
+      LastBounceVolume().Keep(mesh, lights, options, *cached);
+      return *std::move(cached);
+    }
+  }
   IrradianceVolume volume = ComputeBounceVolume(mesh, lights, options);
   LastBounceVolume().Keep(mesh, lights, options, volume);
+  if (!file.empty()) WriteCached(file, key, volume);
   return volume;
 }
 

@@ -22,6 +22,7 @@
 // each other through boxes) and the person's shadow in the bounce light.
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <vector>
 
 #include "sim/scene/mesh.h"
@@ -66,9 +67,23 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
 
 // The bounce light's irradiance volume. The last one computed is kept (a
 // suite or sweep renders one scene many times in one process): the same
-// inputs, bit for bit, return it again.
+// inputs, bit for bit, return it again. Across processes each volume is kept
+// on disk in UserCacheDir()/bounce/ (common/paths.h; IRBENCH_CACHE_DIR=off: no
+// disk cache): a file per scene mesh, lights, options and build of the
+// bounce code (BounceCacheFile), read back only for exactly those, so the
+// volume read is the one computing it gives, bit for bit. A file that is not
+// whole is ignored (a warning) and written again.
 IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
                                const std::vector<IrLight>& lights,
                                const BounceOptions& options = {});
+
+// The disk cache's file for these inputs (empty without a cache folder):
+// "IRBOUNC1", the 64 hex digits of the inputs' SHA-256 (also its name), the
+// volume's origin (3 doubles), spacing (double), dims (3 int32), the number
+// of values (uint64) and the values (3 floats each), in this machine's byte
+// order.
+std::filesystem::path BounceCacheFile(const TriangleMesh& mesh,
+                                      const std::vector<IrLight>& lights,
+                                      const BounceOptions& options = {});
 
 }  // namespace irbench

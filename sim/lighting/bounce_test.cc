@@ -6,8 +6,16 @@
 
 #include <gtest/gtest.h>
 
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <string>
 
 namespace irbench {
 namespace {
@@ -137,6 +145,92 @@ TEST(BounceTest, TheKeptVolumeFollowsItsInputs) {
   for (MeshVertex& v : darker.vertices) v.albedo = 0.25f;
   const IrradianceVolume dim = ComputeBounce(darker, {light});
   EXPECT_NE(dim.values, first.values);
+}
+
+// Sets IRBENCH_CACHE_DIR for one test and restores it after.
+class CacheDirForTest {
+ public:
+  explicit CacheDirForTest(const std::string& value) {
+    if (const char* old = std::getenv("IRBENCH_CACHE_DIR")) old_ = old;
+    ::setenv("IRBENCH_CACHE_DIR", value.c_str(), 1);
+  }
+  ~CacheDirForTest() {
+    if (old_) ::setenv("IRBENCH_CACHE_DIR", old_->c_str(), 1); else ::unsetenv("IRBENCH_CACHE_DIR");
+  }
+
+ private:
+  std::optional<std::string> old_;
+};
+
+std::string ReadBytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void WriteBytes(const std::filesystem::path& file, const std::string& bytes) {
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+void ExpectSameVolume(const IrradianceVolume& a, const IrradianceVolume& b) {
+  EXPECT_EQ(a.origin, b.origin);
+  EXPECT_EQ(a.spacing, b.spacing);
+  EXPECT_EQ(a.dims, b.dims);
+  EXPECT_EQ(a.values, b.values);
+}
+
+// The disk cache (another process's volume) gives exactly what computing
+// gives, only for the same inputs, is really read (a changed value in the
+// file comes back), and a file cut short is computed and written again.
+TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
+  namespace fs = std::filesystem;
+  char dir_template[] = "/tmp/bounce_cache_XXXXXX";
+  ASSERT_NE(::mkdtemp(dir_template), nullptr);
+  const fs::path dir = dir_template;
+  TriangleMesh mesh, other;
+  AppendQuad(mesh, {-1.5, -1.5, 0}, {3, 0, 0}, {0, 3, 0}, Material{0.5f, 0.0f});
+  AppendQuad(mesh, {-1.5, -1.5, 2}, {0, 3, 0}, {3, 0, 0}, Material{0.5f, 0.0f});
+  AppendQuad(other, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, Material{0.5f, 0.0f});
+  IrLight light;
+  light.position = {0, 0, 1.5};
+  light.cone_deg = 120;
+  {
+    CacheDirForTest no_cache("off");
+    EXPECT_TRUE(BounceCacheFile(mesh, {light}).empty());
+  }
+  CacheDirForTest cache(dir.string());
+  const fs::path file = BounceCacheFile(mesh, {light});
+  ASSERT_EQ(file.parent_path(), dir / "bounce");
+  IrLight brighter = light;
+  brighter.power = 2;
+  EXPECT_NE(BounceCacheFile(mesh, {brighter}), file);
+  EXPECT_NE(BounceCacheFile(other, {light}), file);
+  // Computed, and written.
+  ComputeBounce(other, {light});  // not the last volume kept in memory
+  const IrradianceVolume computed = ComputeBounce(mesh, {light});
+  ASSERT_FALSE(computed.empty());
+  ASSERT_TRUE(fs::is_regular_file(file));
+  // The file as a fresh process reads it (the other scene's volume is the one
+  // kept in memory): the same volume, bit for bit.
+  ComputeBounce(other, {light});
+  ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
+  // Read, not computed: the last value changed in the file comes back.
+  const std::string whole = ReadBytes(file);
+  ASSERT_EQ(whole.size(), 8 + 64 + 4 * sizeof(double) + 3 * 4 + 8 + computed.values.size() * 3 * sizeof(float));
+  std::string changed = whole;
+  const float marker = 12345.5f;
+  std::memcpy(changed.data() + changed.size() - sizeof(float), &marker, sizeof(float));
+  WriteBytes(file, changed);
+  ComputeBounce(other, {light});
+  EXPECT_EQ(ComputeBounce(mesh, {light}).values.back()[2], marker);
+  // Cut short: ignored, computed again and written whole.
+  WriteBytes(file, whole.substr(0, whole.size() - 1));
+  ComputeBounce(other, {light});
+  ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
+  EXPECT_EQ(ReadBytes(file), whole);
+  // Brighter light: its own file, its own volume.
+  ComputeBounce(mesh, {brighter});
+  EXPECT_TRUE(fs::is_regular_file(BounceCacheFile(mesh, {brighter})));
+  fs::remove_all(dir);
 }
 
 }  // namespace
