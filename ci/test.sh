@@ -16,12 +16,13 @@ cmake --build build -j"$(nproc)"
 # instead of 663 s for the same tests).
 ctest --test-dir build --output-on-failure -j"$(($(nproc) + 1))"
 # The unit tests under ASan + UBSan (clang, build-san/) and a short run of
-# every fuzzer (docs/fuzzing.md). The fuzzers run a fixed time each, two at a
-# time (the seventh alone), so the sanitized unit tests and the README's first
-# command with a short setting (60 frames rendered, tracked, scored, the
+# every fuzzer (docs/fuzzing.md). The fuzzers run a fixed time each, three at
+# first and then two at a time (three minutes; the seventh no longer alone at
+# the end with a core idle), so the sanitized unit tests and the README's
+# first command with a short setting (60 frames rendered, tracked, scored, the
 # tables printed and report.html written; its output printed when it ends)
 # run beside them: each fuzzer still has its minute, on a share of the cores,
-# and the four minutes are not spent again after it.
+# and the three minutes are not spent again after it.
 SANITIZE_STEPS=build ./ci/sanitize.sh
 SANITIZE_STEPS=fuzz ./ci/sanitize.sh &
 fuzz=$!
