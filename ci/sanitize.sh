@@ -25,6 +25,10 @@ BUILD_DIR=${BUILD_DIR:-build-san}
 FUZZ_SECONDS=${FUZZ_SECONDS:-60}
 JOBS=$(nproc)
 FUZZ_PARALLEL=${FUZZ_PARALLEL:-$((JOBS < 2 ? JOBS : 2))}
+if ! [[ "$FUZZ_PARALLEL" =~ ^[1-9][0-9]*$ ]]; then
+  echo "sanitize: FUZZ_PARALLEL must be a whole number from 1 (got '$FUZZ_PARALLEL')" >&2
+  exit 2
+fi
 ALL_FUZZERS=(bvh asf_amc gltf rig scene suite calibration)
 read -r -a FUZZERS <<<"${FUZZ_TARGETS:-${ALL_FUZZERS[*]}}"
 start=$SECONDS
@@ -118,8 +122,9 @@ run_fuzzers() {
     return 0
   fi
   # Whole rounds of FUZZ_PARALLEL fuzzers; what is left over runs in the first
-  # round, beside the sanitized unit tests, instead of alone at the end with
-  # the other cores idle (7 fuzzers on 2 cores: 3, 2, 2 = three minutes).
+  # round (in ci/test.sh beside the sanitized unit tests) instead of alone at
+  # the end with the other cores idle (7 fuzzers on 2 cores: 3, 2, 2 = three
+  # minutes).
   local n=${#FUZZERS[@]}
   local first=$((n <= FUZZ_PARALLEL ? n : FUZZ_PARALLEL + n % FUZZ_PARALLEL))
   step "fuzz ${FUZZERS[*]}: ${FUZZ_SECONDS} s each, $first at first, then $FUZZ_PARALLEL at a time"

@@ -26,7 +26,7 @@ ctest --test-dir build --output-on-failure -j"$(($(nproc) + 1))"
 SANITIZE_STEPS=build ./ci/sanitize.sh
 SANITIZE_STEPS=fuzz ./ci/sanitize.sh &
 fuzz=$!
-./ci/demo.sh --frames 60 --out build/ci-demo >build/ci-demo.log 2>&1 &
+IRBENCH_CACHE_DIR=build/ci-cache ./ci/demo.sh --frames 60 --out build/ci-demo >build/ci-demo.log 2>&1 &
 demo=$!
 failed=0
 SANITIZE_STEPS=tests ./ci/sanitize.sh || failed=1

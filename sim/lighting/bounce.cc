@@ -281,11 +281,18 @@ namespace {
 // The disk cache (bounce.h). This build of this file: its compile time and
 // compiler. A volume is read only by the build that computed it, so a change
 // to the arithmetic here (or to the inputs' meaning in the headers this file
-// includes) never meets a volume computed the old way.
+// includes) never meets a volume computed the old way. Where builds are made
+// reproducible (SOURCE_DATE_EPOCH fixes __DATE__ and __TIME__), the revision
+// below is what tells them apart: bump it with any change to what
+// BouncePatches or ComputeBounceVolume compute.
+constexpr int kRevision = 1;
 constexpr char kBuildStamp[] = __DATE__ " " __TIME__ " " __VERSION__;
 constexpr char kMagic[8] = {'I', 'R', 'B', 'O', 'U', 'N', 'C', '1'};
-// Files not written for this long are removed when another is written.
+// Files not read or written for this long are removed when another is written.
 constexpr auto kUnusedFor = std::chrono::hours(24 * 30);
+// The largest grid side a file may claim (the scene's own limit is 200,000
+// volume points, docs/sensor.md).
+constexpr int32_t kMaxSide = 1 << 16;
 
 template <typename T>
 void Put(std::string& out, const T& value) {
@@ -295,6 +302,7 @@ void Put(std::string& out, const T& value) {
 // Everything the volume is computed from, and this build.
 std::string CacheKey(const TriangleMesh& mesh, const std::vector<IrLight>& lights, const BounceOptions& options) {
   std::string bytes(kBuildStamp, sizeof(kBuildStamp));
+  Put(bytes, kRevision);
   Put(bytes, options.patch_m);
   Put(bytes, options.grid_m);
   Put(bytes, options.bounces);
@@ -323,11 +331,19 @@ std::string Serialise(const std::string& key, const IrradianceVolume& v) {
   for (const Eigen::Vector3f& e : v.values) {
     for (int c = 0; c < 3; ++c) Put(out, e[c]);
   }
+  Put(out, Fnv1a64(out));
   return out;
 }
 
-// The volume in `bytes` when they are a whole cache file for `key`.
-std::optional<IrradianceVolume> Deserialise(const std::string& key, const std::string& bytes) {
+// The volume in `bytes` when they are a whole, intact cache file for `key`.
+std::optional<IrradianceVolume> Deserialise(const std::string& key, std::string bytes) {
+  // The last 8 bytes: the FNV-1a hash of all before them (a file of the
+  // right length with damaged contents, e.g. zeroed pages after a crash).
+  uint64_t stored_hash = 0;
+  if (bytes.size() < sizeof(stored_hash)) return std::nullopt;
+  std::memcpy(&stored_hash, bytes.data() + bytes.size() - sizeof(stored_hash), sizeof(stored_hash));
+  bytes.resize(bytes.size() - sizeof(stored_hash));
+  if (Fnv1a64(bytes) != stored_hash) return std::nullopt;
   size_t at = 0;
   auto take = [&](void* value, size_t n) {
     if (bytes.size() - at < n) return false;
@@ -346,10 +362,15 @@ std::optional<IrradianceVolume> Deserialise(const std::string& key, const std::s
       !take(&count, sizeof(count))) {
     return std::nullopt;
   }
+  // No volume (every side 0), or sides of 2 or more that Irradiance can
+  // interpolate in, on a finite grid.
+  const bool none = dims[0] == 0 && dims[1] == 0 && dims[2] == 0;
   for (int k = 0; k < 3; ++k) {
-    if (dims[k] < 0) return std::nullopt;
+    if (!none && (dims[k] < 2 || dims[k] > kMaxSide)) return std::nullopt;
+    if (!std::isfinite(v.origin[k])) return std::nullopt;
     v.dims[k] = dims[k];
   }
+  if (!(std::isfinite(v.spacing) && v.spacing > 0)) return std::nullopt;
   if (count != 6 * uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2])) return std::nullopt;
   if (bytes.size() - at != count * 3 * sizeof(float)) return std::nullopt;
   v.values.resize(count);
@@ -372,8 +393,8 @@ std::optional<IrradianceVolume> ReadCached(const std::filesystem::path& file, co
 }
 
 // Writes the volume's file (a file that cannot be written is only a cache
-// miss next time) and removes files of the folder not written for a month
-// (killed writers' temporaries after a day).
+// miss next time) and removes files of the folder not read or written for a
+// month (killed writers' temporaries after a day).
 void WriteCached(const std::filesystem::path& file, const std::string& key, const IrradianceVolume& volume) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -416,6 +437,9 @@ IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
   if (!file.empty()) {
     if (std::optional<IrradianceVolume> cached = ReadCached(file, key)) {
       Log().debug("bounce light: read from {}", file.string());
+      // Read counts as used: the month's pruning spares it.
+      std::error_code ec;
+      std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now(), ec);
       LastBounceVolume().Keep(mesh, lights, options, *cached);
       return *std::move(cached);
     }

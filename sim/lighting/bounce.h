@@ -71,8 +71,11 @@ std::vector<BouncePatch> BouncePatches(const TriangleMesh& mesh,
 // on disk in UserCacheDir()/bounce/ (common/paths.h; IRBENCH_CACHE_DIR=off: no
 // disk cache): a file per scene mesh, lights, options and build of the
 // bounce code (BounceCacheFile), read back only for exactly those, so the
-// volume read is the one computing it gives, bit for bit. A file that is not
-// whole is ignored (a warning) and written again.
+// volume read is the one computing it gives, bit for bit (on this machine:
+// std::cos is the C library's, which may pick another implementation on
+// another processor, so a cache folder shared by different machines may give
+// a volume that differs in the last bits). A file that is not whole or fails
+// its hash is ignored (a warning) and written again.
 IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
                                const std::vector<IrLight>& lights,
                                const BounceOptions& options = {});
@@ -80,8 +83,9 @@ IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
 // The disk cache's file for these inputs (empty without a cache folder):
 // "IRBOUNC1", the 64 hex digits of the inputs' SHA-256 (also its name), the
 // volume's origin (3 doubles), spacing (double), dims (3 int32), the number
-// of values (uint64) and the values (3 floats each), in this machine's byte
-// order.
+// of values (uint64), the values (3 floats each) and the 64-bit FNV-1a hash
+// of everything before it (Fnv1a64, common/atomic_file.h), in this
+// machine's byte order.
 std::filesystem::path BounceCacheFile(const TriangleMesh& mesh,
                                       const std::vector<IrLight>& lights,
                                       const BounceOptions& options = {});

@@ -17,6 +17,9 @@
 #include <optional>
 #include <string>
 
+#include "common/atomic_file.h"
+#include "tests/test_util.h"
+
 namespace irbench {
 namespace {
 
@@ -180,12 +183,15 @@ void ExpectSameVolume(const IrradianceVolume& a, const IrradianceVolume& b) {
 
 // The disk cache (another process's volume) gives exactly what computing
 // gives, only for the same inputs, is really read (a changed value in the
-// file comes back), and a file cut short is computed and written again.
+// file, its hash made good, comes back), and a file cut short, damaged or
+// holding another scene's volume is computed and written again.
 TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   namespace fs = std::filesystem;
-  char dir_template[] = "/tmp/bounce_cache_XXXXXX";
-  ASSERT_NE(::mkdtemp(dir_template), nullptr);
-  const fs::path dir = dir_template;
+  const fs::path dir = testing::FreshTempDir("bounce_cache");
+  struct RemoveAfter {
+    fs::path dir;
+    ~RemoveAfter() { fs::remove_all(dir); }
+  } remove_after{dir};
   TriangleMesh mesh, other;
   AppendQuad(mesh, {-1.5, -1.5, 0}, {3, 0, 0}, {0, 3, 0}, Material{0.5f, 0.0f});
   AppendQuad(mesh, {-1.5, -1.5, 2}, {0, 3, 0}, {3, 0, 0}, Material{0.5f, 0.0f});
@@ -194,8 +200,12 @@ TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   light.position = {0, 0, 1.5};
   light.cone_deg = 120;
   {
+    // No cache: no file, nothing written.
     CacheDirForTest no_cache("off");
     EXPECT_TRUE(BounceCacheFile(mesh, {light}).empty());
+    ComputeBounce(other, {light});
+    ComputeBounce(mesh, {light});
+    EXPECT_TRUE(fs::is_empty(dir));
   }
   CacheDirForTest cache(dir.string());
   const fs::path file = BounceCacheFile(mesh, {light});
@@ -213,24 +223,39 @@ TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   // kept in memory): the same volume, bit for bit.
   ComputeBounce(other, {light});
   ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
-  // Read, not computed: the last value changed in the file comes back.
+  // Read, not computed: the last value changed in the file (and the hash
+  // after it recomputed) comes back.
   const std::string whole = ReadBytes(file);
-  ASSERT_EQ(whole.size(), 8 + 64 + 4 * sizeof(double) + 3 * 4 + 8 + computed.values.size() * 3 * sizeof(float));
-  std::string changed = whole;
+  const size_t header = 8 + 64 + 4 * sizeof(double) + 3 * 4 + 8, hash = 8;
+  ASSERT_EQ(whole.size(), header + computed.values.size() * 3 * sizeof(float) + hash);
+  std::string changed = whole.substr(0, whole.size() - hash);
   const float marker = 12345.5f;
   std::memcpy(changed.data() + changed.size() - sizeof(float), &marker, sizeof(float));
+  const uint64_t changed_hash = Fnv1a64(changed);
+  changed.append(reinterpret_cast<const char*>(&changed_hash), hash);
   WriteBytes(file, changed);
   ComputeBounce(other, {light});
   EXPECT_EQ(ComputeBounce(mesh, {light}).values.back()[2], marker);
-  // Cut short: ignored, computed again and written whole.
-  WriteBytes(file, whole.substr(0, whole.size() - 1));
-  ComputeBounce(other, {light});
+  // Damaged where the hash does not match, or cut short: ignored, computed
+  // again and written whole.
+  std::string damaged = whole;
+  damaged[header + 5] ^= 0x40;
+  for (const std::string& bad : {damaged, whole.substr(0, whole.size() - 1)}) {
+    WriteBytes(file, bad);
+    ComputeBounce(other, {light});
+    ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
+    EXPECT_EQ(ReadBytes(file), whole);
+  }
+  // Another scene's file under this one's name: its key differs inside.
+  const fs::path other_file = BounceCacheFile(other, {light});
+  ASSERT_TRUE(fs::is_regular_file(other_file));
+  fs::copy_file(other_file, file, fs::copy_options::overwrite_existing);
+  ComputeBounce(other, {brighter});
   ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
   EXPECT_EQ(ReadBytes(file), whole);
   // Brighter light: its own file, its own volume.
   ComputeBounce(mesh, {brighter});
   EXPECT_TRUE(fs::is_regular_file(BounceCacheFile(mesh, {brighter})));
-  fs::remove_all(dir);
 }
 
 }  // namespace
