@@ -4,14 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "common/atomic_file.h"
+#include "common/file_bytes.h"
 #include "common/logging.h"
 #include "common/paths.h"
 #include "common/sha256.h"
@@ -336,13 +336,13 @@ std::string Serialise(const std::string& key, const IrradianceVolume& v) {
 }
 
 // The volume in `bytes` when they are a whole, intact cache file for `key`.
-std::optional<IrradianceVolume> Deserialise(const std::string& key, std::string bytes) {
+std::optional<IrradianceVolume> Deserialise(const std::string& key, std::string_view bytes) {
   // The last 8 bytes: the FNV-1a hash of all before them (a file of the
   // right length with damaged contents, e.g. zeroed pages after a crash).
   uint64_t stored_hash = 0;
   if (bytes.size() < sizeof(stored_hash)) return std::nullopt;
   std::memcpy(&stored_hash, bytes.data() + bytes.size() - sizeof(stored_hash), sizeof(stored_hash));
-  bytes.resize(bytes.size() - sizeof(stored_hash));
+  bytes.remove_suffix(sizeof(stored_hash));
   if (Fnv1a64(bytes) != stored_hash) return std::nullopt;
   size_t at = 0;
   auto take = [&](void* value, size_t n) {
@@ -378,15 +378,15 @@ std::optional<IrradianceVolume> Deserialise(const std::string& key, std::string 
   return v;
 }
 
-std::filesystem::path CacheFolder() {
+// The cache file of `key` (empty without a cache folder).
+std::filesystem::path CacheFile(const std::string& key) {
   const std::filesystem::path root = UserCacheDir();
-  return root.empty() ? root : root / "bounce";
+  return root.empty() ? root : root / "bounce" / (key + ".bin");
 }
 
 std::optional<IrradianceVolume> ReadCached(const std::filesystem::path& file, const std::string& key) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = ReadFileBytes(file);
+  if (bytes.empty()) return std::nullopt;  // none yet (or unreadable): a miss
   std::optional<IrradianceVolume> v = Deserialise(key, bytes);
   if (!v) Log().warn("bounce light: ignoring the damaged cache file {} (computing it again)", file.string());
   return v;
@@ -423,17 +423,15 @@ void WriteCached(const std::filesystem::path& file, const std::string& key, cons
 std::filesystem::path BounceCacheFile(const TriangleMesh& mesh,
                                       const std::vector<IrLight>& lights,
                                       const BounceOptions& options) {
-  const std::filesystem::path folder = CacheFolder();
-  return folder.empty() ? folder : folder / (CacheKey(mesh, lights, options) + ".bin");
+  return UserCacheDir().empty() ? std::filesystem::path() : CacheFile(CacheKey(mesh, lights, options));
 }
 
 IrradianceVolume ComputeBounce(const TriangleMesh& mesh,
                                const std::vector<IrLight>& lights,
                                const BounceOptions& options) {
   if (std::optional<IrradianceVolume> kept = LastBounceVolume().Find(mesh, lights, options)) return *std::move(kept);
-  const std::filesystem::path folder = CacheFolder();
-  const std::string key = folder.empty() ? std::string() : CacheKey(mesh, lights, options);
-  const std::filesystem::path file = folder.empty() ? folder : folder / (key + ".bin");
+  const std::string key = UserCacheDir().empty() ? std::string() : CacheKey(mesh, lights, options);
+  const std::filesystem::path file = key.empty() ? std::filesystem::path() : CacheFile(key);
   if (!file.empty()) {
     if (std::optional<IrradianceVolume> cached = ReadCached(file, key)) {
       Log().debug("bounce light: read from {}", file.string());

@@ -12,8 +12,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <optional>
 #include <string>
 
@@ -165,15 +163,6 @@ class CacheDirForTest {
   std::optional<std::string> old_;
 };
 
-std::string ReadBytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void WriteBytes(const std::filesystem::path& file, const std::string& bytes) {
-  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
-}
-
 void ExpectSameVolume(const IrradianceVolume& a, const IrradianceVolume& b) {
   EXPECT_EQ(a.origin, b.origin);
   EXPECT_EQ(a.spacing, b.spacing);
@@ -225,7 +214,7 @@ TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
   // Read, not computed: the last value changed in the file (and the hash
   // after it recomputed) comes back.
-  const std::string whole = ReadBytes(file);
+  const std::string whole = testing::ReadText(file);
   const size_t header = 8 + 64 + 4 * sizeof(double) + 3 * 4 + 8, hash = 8;
   ASSERT_EQ(whole.size(), header + computed.values.size() * 3 * sizeof(float) + hash);
   std::string changed = whole.substr(0, whole.size() - hash);
@@ -233,7 +222,7 @@ TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   std::memcpy(changed.data() + changed.size() - sizeof(float), &marker, sizeof(float));
   const uint64_t changed_hash = Fnv1a64(changed);
   changed.append(reinterpret_cast<const char*>(&changed_hash), hash);
-  WriteBytes(file, changed);
+  testing::WriteText(file, changed);
   ComputeBounce(other, {light});
   EXPECT_EQ(ComputeBounce(mesh, {light}).values.back()[2], marker);
   // Damaged where the hash does not match, or cut short: ignored, computed
@@ -241,10 +230,10 @@ TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   std::string damaged = whole;
   damaged[header + 5] ^= 0x40;
   for (const std::string& bad : {damaged, whole.substr(0, whole.size() - 1)}) {
-    WriteBytes(file, bad);
+    testing::WriteText(file, bad);
     ComputeBounce(other, {light});
     ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
-    EXPECT_EQ(ReadBytes(file), whole);
+    EXPECT_EQ(testing::ReadText(file), whole);
   }
   // Another scene's file under this one's name: its key differs inside.
   const fs::path other_file = BounceCacheFile(other, {light});
@@ -252,7 +241,7 @@ TEST(BounceTest, TheDiskCacheGivesTheComputedVolumeOnlyForItsInputs) {
   fs::copy_file(other_file, file, fs::copy_options::overwrite_existing);
   ComputeBounce(other, {brighter});
   ExpectSameVolume(ComputeBounce(mesh, {light}), computed);
-  EXPECT_EQ(ReadBytes(file), whole);
+  EXPECT_EQ(testing::ReadText(file), whole);
   // Brighter light: its own file, its own volume.
   ComputeBounce(mesh, {brighter});
   EXPECT_TRUE(fs::is_regular_file(BounceCacheFile(mesh, {brighter})));
