@@ -555,6 +555,32 @@ TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
 // of the ankles, a person facing 30 deg from +y. The layers' line
 // extrapolated to the ankles' height is the ankles' midpoint, not the point
 // under the knees or the waist; the feet give the facing direction.
+// Between the legs' measures the root is the model's moved by the last
+// measured offset, which turns with the body and fades.
+TEST(HullLegs, WithoutTheLegsTheLastOffsetTurnsWithTheBodyAndFades) {
+  RootOffsetMemory memory(2.0);
+  // Facing +x: the legs' root 5 cm ahead of the model's and 2 cm to its left (+y).
+  const Vector3d model_root(0.4, -0.3, 0);
+  HullLegs legs;
+  legs.root = model_root + Vector3d(0.05, 0.02, 0);
+  EXPECT_NEAR((memory.Root(model_root, Vector3d(2, 0, 0.5), legs, 1.0 / 30) - legs.root).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((memory.offset() - Eigen::Vector2d(0.05, 0.02)).norm(), 0.0, 1e-12);
+  // Half a second later, no legs, turned to face +y (left is -x), moved.
+  const Vector3d moved(-0.2, 0.6, 0);
+  const double fade = std::exp(-0.5 / 2.0);
+  const Vector3d expected = moved + fade * Vector3d(-0.02, 0.05, 0);
+  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - expected).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - (moved + fade * fade * Vector3d(-0.02, 0.05, 0))).norm(),
+              0.0, 1e-12);
+  // Reset (tracking lost): the model's root.
+  memory.Reset();
+  EXPECT_EQ(memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5), moved);
+  // A body facing straight up (no direction on the floor) keeps no offset.
+  legs.root = moved + Vector3d(0.05, 0, 0);
+  EXPECT_EQ(memory.Root(moved, Vector3d(0, 0, 1), legs, 0.1), legs.root);
+  EXPECT_EQ(memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.1), moved);
+}
+
 TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   VoxelHull hull = EmptyStageHull();
   const double height = 1.75;
@@ -609,12 +635,17 @@ TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   EXPECT_GT((capped->root.head<2>() - mid).dot(forward), 0.01);
   options.max_lean = 0.3;
 
-  // No legs near the model's root, an empty hull, legs leaning more than
-  // max_slope: the model's root stands.
-  EXPECT_FALSE(MeasureHullLegs(hull, model_root + Vector3d(0.8, 0, 0), facing, height, options));
-  EXPECT_FALSE(MeasureHullLegs(EmptyStageHull(), model_root, facing, height, options));
+  // Legs leaning more than max_slope: the root, not the feet's direction.
   options.max_slope = 0.2;
   options.max_lean = 0.2;
+  const auto steep = MeasureHullLegs(hull, model_root, facing, height, options);
+  ASSERT_TRUE(steep);
+  EXPECT_FALSE(steep->toes);
+  // No legs near the model's root, an empty hull, legs leaning more than
+  // root_max_slope: the model's root stands.
+  EXPECT_FALSE(MeasureHullLegs(hull, model_root + Vector3d(0.8, 0, 0), facing, height, options));
+  EXPECT_FALSE(MeasureHullLegs(EmptyStageHull(), model_root, facing, height, options));
+  options.root_max_slope = 0.2;
   EXPECT_FALSE(MeasureHullLegs(hull, model_root, facing, height, options));
   EXPECT_NO_THROW(options.Check());
   options.low = 0.3;  // above `high`

@@ -22,7 +22,10 @@ void HullLegsOptions::Check() const {
   if (!(std::abs(calf) < 0.05)) throw InputError("", where + ".calf", "must be within +-0.05");
   if (!(radius_m > 0)) throw InputError("", where + ".radius_m", "must be > 0");
   if (!(max_slope > 0)) throw InputError("", where + ".max_slope", "must be > 0");
-  if (!(max_lean >= 0 && max_lean <= max_slope)) throw InputError("", where + ".max_lean", "must be in [0, max_slope]");
+  if (!(root_max_slope > 0)) throw InputError("", where + ".root_max_slope", "must be > 0");
+  if (!(max_lean >= 0 && max_lean <= max_slope && max_lean <= root_max_slope)) {
+    throw InputError("", where + ".max_lean", "must be in [0, max_slope] and at most root_max_slope");
+  }
   if (!(anchor_high > low && anchor_high <= high)) throw InputError("", where + ".anchor_high", "must be in (low, high]");
   if (!(weight >= 0 && weight <= 1)) throw InputError("", where + ".weight", "must be in [0, 1]");
   if (!(max_offset_m > 0)) throw InputError("", where + ".max_offset_m", "must be > 0");
@@ -75,10 +78,11 @@ Eigen::Vector2d LayerCentre(const std::vector<Eigen::Vector2d>& points, bool spl
 // lean to the ankles' height `ankle_z` (a kink at the knee or a calf seen
 // by fewer views bends the upper layers: the lean from them is trusted only
 // so far). nullopt with fewer than min_layers layers or a lean beyond
-// max_slope. `layers`: the layers fitted.
+// root_max_slope. `layers`: the layers fitted; `slope`: the line's lean
+// (before the cap).
 std::optional<Eigen::Vector2d> AnklesFromLayers(const std::vector<std::vector<Eigen::Vector2d>>& layer_points,
                                                 bool split, double low, double ankle_z, double height_m,
-                                                const HullLegsOptions& options, int* layers) {
+                                                const HullLegsOptions& options, int* layers, double* slope) {
   Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
   Eigen::Matrix2d atb = Eigen::Matrix2d::Zero();  // columns x, y
   Eigen::Vector2d anchor = Eigen::Vector2d::Zero();
@@ -102,7 +106,8 @@ std::optional<Eigen::Vector2d> AnklesFromLayers(const std::vector<std::vector<Ei
   if (*layers < options.min_layers || anchor_layers == 0 || std::abs(ata.determinant()) < 1e-12) return std::nullopt;
   const Eigen::Matrix2d line = ata.ldlt().solve(atb);  // row 0: intercept (x, y); row 1: slope
   Eigen::Vector2d lean = line.row(1).transpose();
-  if (lean.norm() > options.max_slope) return std::nullopt;
+  *slope = lean.norm();
+  if (*slope > options.root_max_slope) return std::nullopt;
   if (lean.norm() > options.max_lean) lean *= options.max_lean / lean.norm();
   return Eigen::Vector2d(anchor / anchor_layers - lean * (anchor_z / anchor_layers - ankle_z));
 }
@@ -132,8 +137,9 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   // (split_legs) where they give one.
   const double ankle_z = options.ankle * height_m;
   int layers = 0;
+  double slope = 0;
   const std::optional<Eigen::Vector2d> ankles =
-      AnklesFromLayers(layer_points, false, low, ankle_z, height_m, options, &layers);
+      AnklesFromLayers(layer_points, false, low, ankle_z, height_m, options, &layers, &slope);
   if (!ankles) return std::nullopt;
   Eigen::Vector2d facing = forward.head<2>();
   facing = facing.norm() > 1e-9 ? facing.normalized() : Eigen::Vector2d::Zero();
@@ -146,17 +152,35 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
   if (!measured) return std::nullopt;
   if (options.split_legs) {
     int split_layers = 0;
-    const auto split = AnklesFromLayers(layer_points, true, low, ankle_z, height_m, options, &split_layers);
+    double split_slope = 0;
+    const auto split =
+        AnklesFromLayers(layer_points, true, low, ankle_z, height_m, options, &split_layers, &split_slope);
     if (const auto from_split = split ? near_model(*split) : std::nullopt) measured = from_split;
   }
   const Eigen::Vector2d root = model_root.head<2>() + options.weight * (*measured - model_root.head<2>());
   HullLegs out;
   out.root = Eigen::Vector3d(root.x(), root.y(), 0.0);
   out.layers = layers;
-  if (static_cast<int>(feet_points.size()) >= options.min_feet_voxels) {
+  if (slope <= options.max_slope && static_cast<int>(feet_points.size()) >= options.min_feet_voxels) {
     out.toes = LayerCentre(feet_points, false) - *ankles;
   }
   return out;
+}
+
+Eigen::Vector3d RootOffsetMemory::Root(const Eigen::Vector3d& model_root, const Eigen::Vector3d& forward,
+                                       const std::optional<HullLegs>& legs, double dt) {
+  const Eigen::Vector2d flat = forward.head<2>();
+  const Eigen::Vector2d ahead = flat.norm() > 1e-6 ? Eigen::Vector2d(flat.normalized()) : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d left(-ahead.y(), ahead.x());
+  if (legs) {
+    const Eigen::Vector2d offset = legs->root.head<2>() - model_root.head<2>();
+    offset_ = Eigen::Vector2d(offset.dot(ahead), offset.dot(left));
+    return legs->root;
+  }
+  offset_ *= std::exp(-dt / memory_s_);
+  Eigen::Vector3d root = model_root;
+  root.head<2>() += offset_.x() * ahead + offset_.y() * left;
+  return root;
 }
 
 namespace {

@@ -31,7 +31,7 @@ double Millis(std::chrono::steady_clock::time_point since) {
 PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface> screens,
                          const PoseTrackerOptions& options)
     : cameras_(std::move(cameras)), screens_(std::move(screens)), options_(options), rng_(options.seed),
-      calibration_(options) {
+      root_offset_(options.root_offset_memory_s), calibration_(options) {
   options_.Check();
   for (const Camera& cam : cameras_) {
     projections_.push_back(ProjectionMatrix(cam));
@@ -112,11 +112,15 @@ bool PoseTracker::IsStep(const Eigen::Vector2d& velocity_xy) const {
 }
 
 void PoseTracker::MeasureLegs(const FrameFeatures& features, double dt, PoseEstimate* out) {
-  if (!out->tracking || !features.voxels) return;
-  const auto legs = MeasureHullLegs(*features.voxels, out->body.joints[kModelRoot],
-                                    out->body.frames[kLowerBody].linear() * Vector3d::UnitY(), shape_.height_m,
-                                    options_.hull_legs);
-  if (legs && options_.root_from_hull) out->body.joints[kModelRoot] = legs->root;
+  if (!out->tracking || !features.voxels) {
+    root_offset_.Reset();
+    return;
+  }
+  const Vector3d forward = out->body.frames[kLowerBody].linear() * Vector3d::UnitY();
+  const auto legs =
+      MeasureHullLegs(*features.voxels, out->body.joints[kModelRoot], forward, shape_.height_m, options_.hull_legs);
+  const Vector3d root = root_offset_.Root(out->body.joints[kModelRoot], forward, legs, dt);
+  if (options_.root_from_hull) out->body.joints[kModelRoot] = root;
   const double keep = std::exp(-dt / options_.feet_memory_s);
   feet_toes_ = keep * feet_toes_ + (1 - keep) * (legs && legs->toes ? *legs->toes : Vector2d::Zero());
 }
@@ -179,6 +183,7 @@ void PoseTracker::Initialise(const FrameFeatures& features) {
   // mocap suite's arms were 17.50 cm against 17.15, CMU 141_16's shoulders
   // 10.1 against 4.0 cm.
   feet_toes_ = Vector2d::Zero();
+  root_offset_.Reset();
   if (features.voxels && !entering_) {
     const auto legs = MeasureHullLegs(*features.voxels, place.root, Vector3d(facing_xy_.x(), facing_xy_.y(), 0),
                                       shape_.height_m, options_.hull_legs);
