@@ -555,23 +555,32 @@ TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
 // of the ankles, a person facing 30 deg from +y. The layers' line
 // extrapolated to the ankles' height is the ankles' midpoint, not the point
 // under the knees or the waist; the feet give the facing direction.
-// Between the legs' measures the root is the model's moved by the last
-// measured offset, which turns with the body and fades.
-TEST(HullLegs, WithoutTheLegsTheLastOffsetTurnsWithTheBodyAndFades) {
-  RootOffsetMemory memory(2.0);
-  // Facing +x: the legs' root 5 cm ahead of the model's and 2 cm to its left (+y).
+// Between the legs' measures the root is the model's moved by the measures'
+// average offset, which turns with the body and fades.
+TEST(HullLegs, WithoutTheLegsTheAveragedOffsetTurnsWithTheBodyAndFades) {
+  RootOffsetMemory memory(0.2, 2.0);
+  // Facing +x: the legs' root 5 cm ahead of the model's and 2 cm to its
+  // left (+y). The first measure is the average.
   const Vector3d model_root(0.4, -0.3, 0);
   HullLegs legs;
   legs.root = model_root + Vector3d(0.05, 0.02, 0);
   EXPECT_NEAR((memory.Root(model_root, Vector3d(2, 0, 0.5), legs, 1.0 / 30) - legs.root).norm(), 0.0, 1e-12);
   EXPECT_NEAR((memory.offset() - Eigen::Vector2d(0.05, 0.02)).norm(), 0.0, 1e-12);
-  // Half a second later, no legs, turned to face +y (left is -x), moved.
+  // A frame later facing -x, 3 cm ahead (-x) and none to the side: the
+  // average moves that share of the way (exp(-dt / 0.2 s) kept).
+  legs.root = model_root + Vector3d(-0.03, 0, 0);
+  EXPECT_EQ(memory.Root(model_root, Vector3d(-1, 0, 0), legs, 1.0 / 30), legs.root);
+  const double keep = std::exp(-1.0 / 30 / 0.2);
+  const Eigen::Vector2d average = keep * Eigen::Vector2d(0.05, 0.02) + (1 - keep) * Eigen::Vector2d(0.03, 0.0);
+  EXPECT_NEAR((memory.offset() - average).norm(), 0.0, 1e-12);
+  // Half a second later, no legs, turned to face +y (left is -x), moved:
+  // the average faded by exp(-0.5 s / 2 s); a second in, by exp(-1 / 2).
   const Vector3d moved(-0.2, 0.6, 0);
-  const double fade = std::exp(-0.5 / 2.0);
-  const Vector3d expected = moved + fade * Vector3d(-0.02, 0.05, 0);
-  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - expected).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - (moved + fade * fade * Vector3d(-0.02, 0.05, 0))).norm(),
-              0.0, 1e-12);
+  const auto expected = [&](double gap_s) {
+    return Vector3d(moved + std::exp(-gap_s / 2.0) * Vector3d(-average.y(), average.x(), 0));
+  };
+  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - expected(0.5)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - expected(1.0)).norm(), 0.0, 1e-12);
   // Reset (tracking lost): the model's root.
   memory.Reset();
   EXPECT_EQ(memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5), moved);

@@ -173,13 +173,18 @@ Eigen::Vector3d RootOffsetMemory::Root(const Eigen::Vector3d& model_root, const 
   const Eigen::Vector2d ahead = flat.norm() > 1e-6 ? Eigen::Vector2d(flat.normalized()) : Eigen::Vector2d::Zero();
   const Eigen::Vector2d left(-ahead.y(), ahead.x());
   if (legs) {
-    const Eigen::Vector2d offset = legs->root.head<2>() - model_root.head<2>();
-    offset_ = Eigen::Vector2d(offset.dot(ahead), offset.dot(left));
+    const Eigen::Vector2d d = legs->root.head<2>() - model_root.head<2>();
+    const Eigen::Vector2d offset(d.dot(ahead), d.dot(left));
+    const double keep = measured_ ? std::exp(-dt / smoothing_s_) : 0.0;
+    offset_ = keep * offset_ + (1 - keep) * offset;
+    measured_ = true;
+    gap_s_ = 0;
     return legs->root;
   }
-  offset_ *= std::exp(-dt / memory_s_);
+  gap_s_ += dt;
+  const Eigen::Vector2d faded = std::exp(-gap_s_ / memory_s_) * offset_;
   Eigen::Vector3d root = model_root;
-  root.head<2>() += offset_.x() * ahead + offset_.y() * left;
+  root.head<2>() += faded.x() * ahead + faded.y() * left;
   return root;
 }
 

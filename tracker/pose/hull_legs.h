@@ -63,7 +63,7 @@ struct HullLegsOptions {
   // a dance's or a jump's kept the model's root, 4-11 cm ahead of the
   // ankles on CMU motion capture (the 16 clips' first 8 s, 2026-12-07:
   // root 5.73 -> 5.36 cm with this alone, the library motions' 1.81 ->
-  // 1.78; docs/tracker.md).
+  // 1.78, the harsh preset's 3.63 -> 3.70; docs/tracker.md).
   double max_slope = 1.0;
   double root_max_slope = 3.0;
   double max_offset_m = 0.3;
@@ -103,33 +103,44 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
                                         const HullLegsOptions& options = {});
 
 // The root reported frame by frame: the legs' (MeasureHullLegs) where they
-// give one; elsewhere the model's root moved by the last measured offset
-// from it, kept in the lower body's frame (forward and to the left: it
-// turns with the body) and fading over `memory_s`. How far a person's waist
-// stands ahead of their ankles changes with their posture, not from frame
-// to frame, so in a frame without the legs (a leg lifted high, a jump, the
-// layers too thin) the last offset is a better guess than none: on CMU
-// motion capture those frames' model roots stood 4-11 cm ahead of the
-// truth's (the 16 clips' first 8 s, 2026-12-07: CMU root 5.73 -> 5.37 cm
-// with this alone, the library motions' 1.81 -> 1.78; fades of 0.5-10 s,
-// or the measured offset before the blend with the model's, measured
-// alike; docs/tracker.md).
+// give one; elsewhere the model's root moved by the recent measured offset
+// from it. How far a person's waist stands ahead of their ankles changes
+// with their posture, not from frame to frame, so in a short gap of the
+// legs' measures (a leg lifted high, a jump, the layers too thin) the
+// offset of the frames before is a better guess than none: on CMU motion
+// capture those frames' model roots stood 4-11 cm ahead of the truth's.
+// The offset is kept in the lower body's frame (forward and to the left: it
+// turns with the body), averaged over `smoothing_s` of measures (a noisy
+// sensor's measures scatter: with the last one alone the harsh preset's
+// root got worse) and fades over `memory_s` without one. Measured on the
+// 16 CMU clips' first 8 s, 4 library scenarios and the harsh preset's demo
+// (2026-12-07; docs/tracker.md): with root_max_slope, CMU root 5.73 ->
+// 5.30 cm, library 1.81 -> 1.78, harsh unchanged (3.63); the last offset
+// held over 2 s gave the same on CMU but harsh 3.63 -> 4.48.
 class RootOffsetMemory {
  public:
-  explicit RootOffsetMemory(double memory_s) : memory_s_(memory_s) {}
+  RootOffsetMemory(double smoothing_s, double memory_s) : smoothing_s_(smoothing_s), memory_s_(memory_s) {}
   // The root for this frame. `model_root`: the model's; `forward`: the way
   // the lower body faces (world; x and y used, need not be unit; with none
   // on the floor the offset is not kept); `legs`: this frame's measure, if
   // any; `dt`: seconds since the last frame.
   Eigen::Vector3d Root(const Eigen::Vector3d& model_root, const Eigen::Vector3d& forward,
                        const std::optional<HullLegs>& legs, double dt);
-  void Reset() { offset_ = Eigen::Vector2d::Zero(); }
-  // Forward and to the left, metres.
+  void Reset() {
+    offset_ = Eigen::Vector2d::Zero();
+    measured_ = false;
+    gap_s_ = 0;
+  }
+  // The measures' average offset, forward and to the left (metres), before
+  // the fade.
   const Eigen::Vector2d& offset() const { return offset_; }
 
  private:
+  double smoothing_s_;
   double memory_s_;
   Eigen::Vector2d offset_ = Eigen::Vector2d::Zero();
+  bool measured_ = false;  // a measure since the last Reset
+  double gap_s_ = 0;       // seconds since the last measure
 };
 
 // Are the feet on the floor: at least min_feet_voxels occupied voxels of

@@ -31,7 +31,7 @@ double Millis(std::chrono::steady_clock::time_point since) {
 PoseTracker::PoseTracker(std::vector<Camera> cameras, std::vector<ScreenSurface> screens,
                          const PoseTrackerOptions& options)
     : cameras_(std::move(cameras)), screens_(std::move(screens)), options_(options), rng_(options.seed),
-      root_offset_(options.root_offset_memory_s), calibration_(options) {
+      root_offset_(options.root_offset_smoothing_s, options.root_offset_memory_s), calibration_(options) {
   options_.Check();
   for (const Camera& cam : cameras_) {
     projections_.push_back(ProjectionMatrix(cam));

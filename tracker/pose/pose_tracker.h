@@ -163,8 +163,8 @@ class PoseTracker {
   // The feet's direction (HullLegs::toes), averaged over feet_memory_s; zero
   // before the feet are seen.
   Eigen::Vector2d feet_toes_ = Eigen::Vector2d::Zero();
-  // The root between the legs' measures (root_offset_memory_s); empty
-  // while not tracking.
+  // The root between the legs' measures (root_offset_smoothing_s,
+  // root_offset_memory_s); empty while not tracking.
   RootOffsetMemory root_offset_;
   // The feet's average shows a heading: heading_from_feet, and it reaches
   // feet_min_m.

@@ -54,6 +54,7 @@ void PoseTrackerOptions::Check() const {
   hull_head.Check();
   hull_legs.Check();
   if (!(feet_memory_s > 0)) throw InputError("", "pose.feet_memory_s", "must be positive");
+  if (!(root_offset_smoothing_s > 0)) throw InputError("", "pose.root_offset_smoothing_s", "must be positive");
   if (!(root_offset_memory_s > 0)) throw InputError("", "pose.root_offset_memory_s", "must be positive");
   if (!(feet_min_m >= 0)) throw InputError("", "pose.feet_min_m", "must be non-negative");
   if (!(step_max_speed_mps >= 0)) throw InputError("", "pose.step_max_speed_mps", "must be non-negative");

@@ -146,9 +146,10 @@ struct PoseTrackerOptions {
   bool root_from_hull = true;
   HullLegsOptions hull_legs;
   // In a frame where the legs give no root, the model's root moved by the
-  // last measured offset, fading over root_offset_memory_s
-  // (RootOffsetMemory, hull_legs.h).
-  double root_offset_memory_s = 2.0;
+  // measured offset averaged over root_offset_smoothing_s, fading over
+  // root_offset_memory_s (RootOffsetMemory, hull_legs.h).
+  double root_offset_smoothing_s = 0.2;
+  double root_offset_memory_s = 0.25;
   // The heading priors' preferred direction, while the user stands, from
   // the feet (HullLegs::toes, averaged over feet_memory_s) when that average
   // reaches feet_min_m; the screens' otherwise. Front and back look alike
