@@ -550,11 +550,6 @@ TEST(Pointing, HullHeadCentreIsWhereTheVoxelsShowTheHead) {
 }
 
 
-// The root is read off the hull's lower legs: two shins leaning forward (the
-// knees 12 cm ahead of the ankles, as people stand), feet reaching forward
-// of the ankles, a person facing 30 deg from +y. The layers' line
-// extrapolated to the ankles' height is the ankles' midpoint, not the point
-// under the knees or the waist; the feet give the facing direction.
 // Between the legs' measures the root is the model's moved by the measures'
 // average offset, which turns with the body and fades.
 TEST(HullLegs, WithoutTheLegsTheAveragedOffsetTurnsWithTheBodyAndFades) {
@@ -576,20 +571,40 @@ TEST(HullLegs, WithoutTheLegsTheAveragedOffsetTurnsWithTheBodyAndFades) {
   // Half a second later, no legs, turned to face +y (left is -x), moved:
   // the average faded by exp(-0.5 s / 2 s); a second in, by exp(-1 / 2).
   const Vector3d moved(-0.2, 0.6, 0);
-  const auto expected = [&](double gap_s) {
-    return Vector3d(moved + std::exp(-gap_s / 2.0) * Vector3d(-average.y(), average.x(), 0));
-  };
-  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - expected(0.5)).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5) - expected(1.0)).norm(), 0.0, 1e-12);
-  // Reset (tracking lost): the model's root.
-  memory.Reset();
-  EXPECT_EQ(memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.5), moved);
-  // A body facing straight up (no direction on the floor) keeps no offset.
-  legs.root = moved + Vector3d(0.05, 0, 0);
+  const Vector3d up(0, 1, 0);
+  const auto turned = [](const Eigen::Vector2d& o) { return Vector3d(-o.y(), o.x(), 0); };  // facing +y
+  EXPECT_NEAR((memory.Root(moved, up, std::nullopt, 0.5) - (moved + std::exp(-0.25) * turned(average))).norm(), 0.0,
+              1e-12);
+  EXPECT_NEAR((memory.Root(moved, up, std::nullopt, 0.5) - (moved + std::exp(-0.5) * turned(average))).norm(), 0.0,
+              1e-12);
+  // A measure after the gap is averaged with the faded average; the next
+  // gap fades from there (the clock restarts at the measure).
+  legs.root = moved + Vector3d(0, 0.04, 0);  // 4 cm ahead
+  EXPECT_EQ(memory.Root(moved, up, legs, 1.0 / 30), legs.root);
+  const Eigen::Vector2d after = keep * std::exp(-0.5) * average + (1 - keep) * Eigen::Vector2d(0.04, 0.0);
+  EXPECT_NEAR((memory.offset() - after).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((memory.Root(moved, up, std::nullopt, 0.1) - (moved + std::exp(-0.05) * turned(after))).norm(), 0.0,
+              1e-12);
+  // A body facing straight up (no direction on the floor) gets the legs'
+  // root, or the model's, and leaves the average alone.
+  legs.root = moved + Vector3d(0.3, 0, 0);
   EXPECT_EQ(memory.Root(moved, Vector3d(0, 0, 1), legs, 0.1), legs.root);
-  EXPECT_EQ(memory.Root(moved, Vector3d(0, 1, 0), std::nullopt, 0.1), moved);
+  EXPECT_EQ(memory.Root(moved, Vector3d(0, 0, 1), std::nullopt, 0.1), moved);
+  EXPECT_NEAR((memory.offset() - after).norm(), 0.0, 1e-12);
+  // Reset (tracking lost): the model's root, and the next measure is the
+  // whole average.
+  memory.Reset();
+  EXPECT_EQ(memory.Root(moved, up, std::nullopt, 0.5), moved);
+  legs.root = moved + Vector3d(0.01, 0.02, 0);  // 2 cm ahead, 1 cm to the right
+  EXPECT_EQ(memory.Root(moved, up, legs, 1.0 / 30), legs.root);
+  EXPECT_NEAR((memory.offset() - Eigen::Vector2d(0.02, -0.01)).norm(), 0.0, 1e-12);
 }
 
+// The root is read off the hull's lower legs: two shins leaning forward (the
+// knees 12 cm ahead of the ankles, as people stand), feet reaching forward
+// of the ankles, a person facing 30 deg from +y. The layers' line
+// extrapolated to the ankles' height is the ankles' midpoint, not the point
+// under the knees or the waist; the feet give the facing direction.
 TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   VoxelHull hull = EmptyStageHull();
   const double height = 1.75;
@@ -644,11 +659,14 @@ TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   EXPECT_GT((capped->root.head<2>() - mid).dot(forward), 0.01);
   options.max_lean = 0.3;
 
-  // Legs leaning more than max_slope: the root, not the feet's direction.
-  options.max_slope = 0.2;
+  // Legs leaning more than max_slope: the same root, not the feet's direction.
   options.max_lean = 0.2;
+  const auto gentle = MeasureHullLegs(hull, model_root, facing, height, options);
+  ASSERT_TRUE(gentle && gentle->toes);
+  options.max_slope = 0.2;
   const auto steep = MeasureHullLegs(hull, model_root, facing, height, options);
   ASSERT_TRUE(steep);
+  EXPECT_EQ(steep->root, gentle->root);
   EXPECT_FALSE(steep->toes);
   // No legs near the model's root, an empty hull, legs leaning more than
   // root_max_slope: the model's root stands.
@@ -657,9 +675,18 @@ TEST(HullLegs, TheRootIsTheAnklesMidpointWhateverTheShinsLean) {
   options.root_max_slope = 0.2;
   EXPECT_FALSE(MeasureHullLegs(hull, model_root, facing, height, options));
   EXPECT_NO_THROW(options.Check());
+  options.root_max_slope = 0.1;  // below max_slope
+  EXPECT_THROW(options.Check(), InputError);
+  options.root_max_slope = 0.2;
   options.low = 0.3;  // above `high`
   EXPECT_THROW(options.Check(), InputError);
   options = HullLegsOptions();
+  PoseTrackerOptions tracker_options;
+  tracker_options.root_offset_smoothing_s = 0;
+  EXPECT_THROW(tracker_options.Check(), InputError);
+  tracker_options = PoseTrackerOptions();
+  tracker_options.root_offset_memory_s = -1;
+  EXPECT_THROW(tracker_options.Check(), InputError);
 
   // The feet are on the floor where the floor layer holds them; lifted
   // 20 cm (a jump), or far from the root, they are not.

@@ -22,10 +22,8 @@ void HullLegsOptions::Check() const {
   if (!(std::abs(calf) < 0.05)) throw InputError("", where + ".calf", "must be within +-0.05");
   if (!(radius_m > 0)) throw InputError("", where + ".radius_m", "must be > 0");
   if (!(max_slope > 0)) throw InputError("", where + ".max_slope", "must be > 0");
-  if (!(root_max_slope > 0)) throw InputError("", where + ".root_max_slope", "must be > 0");
-  if (!(max_lean >= 0 && max_lean <= max_slope && max_lean <= root_max_slope)) {
-    throw InputError("", where + ".max_lean", "must be in [0, max_slope] and at most root_max_slope");
-  }
+  if (!(root_max_slope >= max_slope)) throw InputError("", where + ".root_max_slope", "must be >= max_slope");
+  if (!(max_lean >= 0 && max_lean <= max_slope)) throw InputError("", where + ".max_lean", "must be in [0, max_slope]");
   if (!(anchor_high > low && anchor_high <= high)) throw InputError("", where + ".anchor_high", "must be in (low, high]");
   if (!(weight >= 0 && weight <= 1)) throw InputError("", where + ".weight", "must be in [0, 1]");
   if (!(max_offset_m > 0)) throw InputError("", where + ".max_offset_m", "must be > 0");
@@ -169,23 +167,26 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
 
 Eigen::Vector3d RootOffsetMemory::Root(const Eigen::Vector3d& model_root, const Eigen::Vector3d& forward,
                                        const std::optional<HullLegs>& legs, double dt) {
+  if (!legs) gap_s_ += dt;
+  // A body with no direction on the floor can neither keep nor apply an
+  // offset in its frame.
   const Eigen::Vector2d flat = forward.head<2>();
-  const Eigen::Vector2d ahead = flat.norm() > 1e-6 ? Eigen::Vector2d(flat.normalized()) : Eigen::Vector2d::Zero();
+  if (flat.norm() <= 1e-9) return legs ? legs->root : model_root;
+  const Eigen::Vector2d ahead = flat.normalized();
   const Eigen::Vector2d left(-ahead.y(), ahead.x());
-  if (legs) {
-    const Eigen::Vector2d d = legs->root.head<2>() - model_root.head<2>();
-    const Eigen::Vector2d offset(d.dot(ahead), d.dot(left));
-    const double keep = measured_ ? std::exp(-dt / smoothing_s_) : 0.0;
-    offset_ = keep * offset_ + (1 - keep) * offset;
-    measured_ = true;
-    gap_s_ = 0;
-    return legs->root;
-  }
-  gap_s_ += dt;
+  // The average as it stands: faded over the time without a measure.
   const Eigen::Vector2d faded = std::exp(-gap_s_ / memory_s_) * offset_;
-  Eigen::Vector3d root = model_root;
-  root.head<2>() += faded.x() * ahead + faded.y() * left;
-  return root;
+  if (!legs) {
+    Eigen::Vector3d root = model_root;
+    root.head<2>() += faded.x() * ahead + faded.y() * left;
+    return root;
+  }
+  const Eigen::Vector2d d = legs->root.head<2>() - model_root.head<2>();
+  const double keep = measured_ ? std::exp(-dt / smoothing_s_) : 0.0;
+  offset_ = keep * faded + (1 - keep) * Eigen::Vector2d(d.dot(ahead), d.dot(left));
+  measured_ = true;
+  gap_s_ = 0;
+  return legs->root;
 }
 
 namespace {

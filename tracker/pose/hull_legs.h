@@ -112,18 +112,19 @@ std::optional<HullLegs> MeasureHullLegs(const VoxelHull& hull, const Eigen::Vect
 // The offset is kept in the lower body's frame (forward and to the left: it
 // turns with the body), averaged over `smoothing_s` of measures (a noisy
 // sensor's measures scatter: with the last one alone the harsh preset's
-// root got worse) and fades over `memory_s` without one. Measured on the
-// 16 CMU clips' first 8 s, 4 library scenarios and the harsh preset's demo
+// root got worse) and fades over `memory_s` without one (the average too:
+// a measure after a long gap is nearly the whole of it). Measured on the
+// 16 CMU clips' first 8 s, 8 library scenarios and the harsh preset's demo
 // (2026-12-07; docs/tracker.md): with root_max_slope, CMU root 5.73 ->
-// 5.30 cm, library 1.81 -> 1.78, harsh unchanged (3.63); the last offset
+// 5.31 cm, library about 1 mm better, harsh 3.63 -> 3.67; the last offset
 // held over 2 s gave the same on CMU but harsh 3.63 -> 4.48.
 class RootOffsetMemory {
  public:
   RootOffsetMemory(double smoothing_s, double memory_s) : smoothing_s_(smoothing_s), memory_s_(memory_s) {}
   // The root for this frame. `model_root`: the model's; `forward`: the way
   // the lower body faces (world; x and y used, need not be unit; with none
-  // on the floor the offset is not kept); `legs`: this frame's measure, if
-  // any; `dt`: seconds since the last frame.
+  // on the floor the frame neither changes nor uses the average); `legs`:
+  // this frame's measure, if any; `dt`: seconds since the last frame.
   Eigen::Vector3d Root(const Eigen::Vector3d& model_root, const Eigen::Vector3d& forward,
                        const std::optional<HullLegs>& legs, double dt);
   void Reset() {
@@ -131,8 +132,8 @@ class RootOffsetMemory {
     measured_ = false;
     gap_s_ = 0;
   }
-  // The measures' average offset, forward and to the left (metres), before
-  // the fade.
+  // The measures' average offset, forward and to the left (metres), as of
+  // the last measure (before the fade since).
   const Eigen::Vector2d& offset() const { return offset_; }
 
  private:
@@ -140,7 +141,7 @@ class RootOffsetMemory {
   double memory_s_;
   Eigen::Vector2d offset_ = Eigen::Vector2d::Zero();
   bool measured_ = false;  // a measure since the last Reset
-  double gap_s_ = 0;       // seconds since the last measure
+  double gap_s_ = 0;       // seconds of frames without a measure since the last
 };
 
 // Are the feet on the floor: at least min_feet_voxels occupied voxels of
