@@ -106,7 +106,7 @@ std::optional<Eigen::Vector2d> AnklesFromLayers(const std::vector<std::vector<Ei
   Eigen::Vector2d lean = line.row(1).transpose();
   *slope = lean.norm();
   if (*slope > options.root_max_slope) return std::nullopt;
-  if (lean.norm() > options.max_lean) lean *= options.max_lean / lean.norm();
+  if (*slope > options.max_lean) lean *= options.max_lean / *slope;
   return Eigen::Vector2d(anchor / anchor_layers - lean * (anchor_z / anchor_layers - ankle_z));
 }
 
