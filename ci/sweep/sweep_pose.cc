@@ -1,6 +1,7 @@
 #include "ci/sweep/sweep_pose.h"
 
 #include <cmath>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "sim/body/skeleton.h"
@@ -22,53 +23,104 @@ nlohmann::json Key(double t, const std::map<std::string, Eigen::Vector3d>& joint
   return out;
 }
 
+// One component: a number (returned) or a range (added to `pose.dims` and
+// its `from` returned), within lo..hi.
+double ReadComponent(const JsonNode& v, PoseDim dim, double lo, double hi, const std::string& unit, bool grid,
+                     PoseAxis* pose) {
+  const auto text = [](double x) {
+    std::ostringstream out;
+    out << x;
+    return out.str();
+  };
+  const std::string within = "must be within " + text(lo) + ".." + text(hi) + unit;
+  if (v.raw().is_number()) {
+    const double fixed = v.Number();
+    if (!(fixed >= lo && fixed <= hi)) v.Fail(within);
+    return fixed;
+  }
+  v.CheckKeys({"from", "to", "steps"});
+  dim.range.from = v.GetDouble("from");
+  dim.range.to = v.GetDouble("to");
+  dim.range.steps = v.Has("steps") ? v.GetInt("steps") : 1;
+  if (dim.range.steps < 1 || dim.range.steps > 1000) v["steps"].Fail("must be in 1..1000");
+  if (!(dim.range.from >= lo && dim.range.from <= hi) || !(dim.range.to >= lo && dim.range.to <= hi)) {
+    v.Fail("from and to " + within);
+  }
+  if (dim.range.steps > 1 && dim.range.from == dim.range.to) v.Fail("an empty range: from equals to with several steps");
+  if (grid && dim.range.steps == 1 && dim.range.from != dim.range.to) v.Fail("from and to differ: give steps (a grid)");
+  pose->dims.push_back(dim);
+  return dim.range.from;
+}
+
 }  // namespace
 
 PoseAxis ReadPoseAxis(const JsonNode& a, bool grid) {
-  a.CheckKeys({"pose", "joints", "move_s", "hold_s"});
+  a.CheckKeys({"pose", "joints", "atoms", "move_s", "hold_s"});
   PoseAxis pose;
   pose.move_s = a.GetDouble("move_s", 1.0);
   pose.hold_s = a.GetDouble("hold_s", 2.0);
   if (!(pose.move_s >= 0.1 && pose.move_s <= 60)) a["move_s"].Fail("must be in 0.1..60 s");
   if (!(pose.hold_s >= 0.1 && pose.hold_s <= 600)) a["hold_s"].Fail("must be in 0.1..600 s");
-  const JsonNode joints = a["joints"];
-  if (joints.Keys().empty()) joints.Fail("no joints");
-  for (const std::string& name : joints.Keys()) {
-    const JsonNode j = joints[name];
-    if (!JointFromName(name)) j.Fail("unknown joint (see docs/formats.md for the names)");
-    if (j.Size() != 3) j.Fail("expected [x, y, z]: three numbers or ranges");
-    Eigen::Vector3d fixed;
-    for (int c = 0; c < 3; ++c) {
-      const JsonNode v = j[size_t(c)];
-      if (v.raw().is_number()) {
-        fixed[c] = v.Number();
-        if (!(std::abs(fixed[c]) <= kMaxDeg)) v.Fail("must be within ±360 degrees");
-        continue;
+  if (a.Has("joints") == a.Has("atoms")) a.Fail("give either `joints` (rotations) or `atoms` (the atoms' weights)");
+  pose.atoms = a.Has("atoms");
+  if (pose.atoms) {
+    const JsonNode arms = a["atoms"];
+    if (arms.Keys().empty()) arms.Fail("no arms");
+    for (const std::string& arm : arms.Keys()) {
+      const JsonNode w = arms[arm];
+      if (arm != "right" && arm != "left") w.Fail("an arm is `right` or `left`");
+      if (w.Keys().empty()) w.Fail("no atoms");
+      std::array<double, 5> weights{};
+      for (const std::string& name : w.Keys()) {
+        if (name.size() != 2 || name[0] != 'A' || name[1] < '0' || name[1] > '4') {
+          w[name].Fail("unknown atom (A0 rest, A1 horizontal, A2 overhead, A3 diagonal up, A4 diagonal down)");
+        }
+        PoseDim dim{arm, name[1] - '0', {}, true};
+        weights[dim.component] = ReadComponent(w[name], dim, 0, 1, "", grid, &pose);
       }
-      v.CheckKeys({"from", "to", "steps"});
-      PoseDim dim;
-      dim.joint = name;
-      dim.component = c;
-      dim.range.from = v.GetDouble("from");
-      dim.range.to = v.GetDouble("to");
-      dim.range.steps = v.Has("steps") ? v.GetInt("steps") : 1;
-      if (dim.range.steps < 1 || dim.range.steps > 1000) v["steps"].Fail("must be in 1..1000");
-      if (!(std::abs(dim.range.from) <= kMaxDeg) || !(std::abs(dim.range.to) <= kMaxDeg)) {
-        v.Fail("from and to must be within ±360 degrees");
-      }
-      if (dim.range.steps > 1 && dim.range.from == dim.range.to) v.Fail("an empty range: from equals to with several steps");
-      if (grid && dim.range.steps == 1 && dim.range.from != dim.range.to) v.Fail("from and to differ: give steps (a grid)");
-      fixed[c] = dim.range.from;
-      pose.dims.push_back(dim);
+      pose.weights[arm] = weights;
     }
-    pose.fixed[name] = fixed;
+  } else {
+    const JsonNode joints = a["joints"];
+    if (joints.Keys().empty()) joints.Fail("no joints");
+    for (const std::string& name : joints.Keys()) {
+      const JsonNode j = joints[name];
+      if (!JointFromName(name)) j.Fail("unknown joint (see docs/formats.md for the names)");
+      if (j.Size() != 3) j.Fail("expected [x, y, z]: three numbers or ranges");
+      Eigen::Vector3d fixed;
+      for (int c = 0; c < 3; ++c) {
+        fixed[c] = ReadComponent(j[size_t(c)], PoseDim{name, c, {}, false}, -kMaxDeg, kMaxDeg, " degrees", grid, &pose);
+      }
+      pose.fixed[name] = fixed;
+    }
   }
-  if (pose.dims.empty()) joints.Fail("no ranges: a pose axis needs at least one component that varies");
+  if (pose.dims.empty()) {
+    a[pose.atoms ? "atoms" : "joints"].Fail("no ranges: a pose axis needs at least one component that varies");
+  }
   return pose;
 }
 
 void WritePoseMotion(const PoseAxis& pose, const std::vector<double>& values, const std::string& name,
                      const std::string& description, const std::filesystem::path& file) {
+  std::filesystem::create_directories(file.parent_path());
+  if (pose.atoms) {
+    // A session of the library's `posture` motion, so that the rest posture
+    // and the tempo are the person's own.
+    std::map<std::string, std::array<double, 5>> weights = pose.weights;
+    for (size_t d = 0; d < pose.dims.size(); ++d) weights[pose.dims[d].joint][pose.dims[d].component] = values[d];
+    nlohmann::json item = {{"motion", "posture"}, {"move_s", pose.move_s}, {"hold_s", pose.hold_s}};
+    for (const auto& [arm, w] : weights) {
+      item[arm] = nlohmann::json::object();
+      for (int atom = 0; atom < 5; ++atom) {
+        if (w[atom] > 0) item[arm]["A" + std::to_string(atom)] = w[atom];
+      }
+      if (item[arm].empty()) item[arm] = "A0";
+    }
+    const nlohmann::json session = {
+        {"format", "irbench.session/1"}, {"name", name}, {"description", description}, {"items", {item}}};
+    AtomicWriteFile(file, session.dump(1) + "\n");
+    return;
+  }
   const std::map<std::string, Eigen::Vector3d> standing = Standing();
   std::map<std::string, Eigen::Vector3d> held = standing;
   for (const auto& [joint, r] : pose.fixed) held[joint] = r;
@@ -81,7 +133,6 @@ void WritePoseMotion(const PoseAxis& pose, const std::vector<double>& values, co
                                  {"name", name},
                                  {"description", description},
                                  {"keys", {Key(0, start), Key(pose.move_s, held), Key(pose.move_s + pose.hold_s, held)}}};
-  std::filesystem::create_directories(file.parent_path());
   AtomicWriteFile(file, motion.dump(1) + "\n");
 }
 

@@ -51,10 +51,10 @@ std::string CoordinateText(const nlohmann::json& v) {
   return v.dump();
 }
 
-// A pose's ranged components' names: "right_shoulder.z".
+// A pose's ranged components' names: "right_shoulder.z", "right.A2".
 std::vector<std::string> PoseNames(const PoseAxis& pose) {
   std::vector<std::string> out;
-  for (const PoseDim& d : pose.dims) out.push_back(d.joint + "." + "xyz"[d.component]);
+  for (const PoseDim& d : pose.dims) out.push_back(d.Label());
   return out;
 }
 

@@ -597,7 +597,7 @@ nlohmann::json PointCoordinates(const SweepSpec& spec, const SweepPoint& point) 
     const AxisValue& at = point.at[k];
     if (const auto* pose = std::get_if<PoseAxis>(&axis.axis)) {
       for (size_t d = 0; d < pose->dims.size(); ++d) {
-        out[axis.name + "." + pose->dims[d].joint + "." + "xyz"[pose->dims[d].component]] = at.pose[d];
+        out[axis.name + "." + pose->dims[d].Label()] = at.pose[d];
       }
     } else if (const auto* p = std::get_if<PlacementAxis>(&axis.axis)) {
       out[axis.name + ".along"] = at.along;
@@ -631,11 +631,11 @@ Scenario PointScenario(const SweepSpec& spec, const SweepPoint& point, const fs:
       const fs::path file = fs::absolute(out / "motions" / (PointName(point.index) + ".json"));
       nlohmann::json held = nlohmann::json::object();
       for (size_t d = 0; d < pose->dims.size(); ++d) {
-        held[pose->dims[d].joint + "." + "xyz"[pose->dims[d].component]] = point.at[k].pose[d];
+        held[pose->dims[d].Label()] = point.at[k].pose[d];
       }
       WritePoseMotion(*pose, point.at[k].pose, spec.name + "-" + PointName(point.index),
                       "Sweep " + spec.name + " point " + std::to_string(point.index) + ", pose " + spec.axes[k].name +
-                          " (degrees, docs/formats.md): " + held.dump(),
+                          (pose->atoms ? " (atoms' weights, docs/motion.md): " : " (degrees, docs/formats.md): ") + held.dump(),
                       file);
       keys["motion"] = file.string();
     }

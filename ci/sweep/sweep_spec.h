@@ -13,6 +13,7 @@
 // local worker, a Slurm array task) can run point i alone.
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -49,17 +50,27 @@ struct PlacementAxis {
   SweepRange pan, tilt;
 };
 
-// An arm pose held (sweep_pose.h): joint rotations in the keyframe
-// convention (docs/formats.md: [x, y, z] degrees, ZXY), each component fixed
-// or a range; a point's motion stands, moves into the pose in `move_s`,
-// holds it `hold_s`.
+// An arm pose held (sweep_pose.h), in one of two spaces: `joints`, joint
+// rotations in the keyframe convention (docs/formats.md: [x, y, z] degrees,
+// ZXY), each component fixed or a range; or `atoms`, per arm the posture
+// atoms' weights (the library's `posture` motion: the rest posture A0 plus
+// each weight times its atom's departure from it), each fixed or a range.
+// A point's motion stands, moves into the pose in `move_s`, holds it
+// `hold_s`.
 struct PoseDim {
-  std::string joint;
-  int component = 0;  // 0 x, 1 y, 2 z
+  std::string joint;  // joints: the joint; atoms: the arm, "right" or "left"
+  int component = 0;  // joints: 0 x, 1 y, 2 z; atoms: the atom, 0..4
   SweepRange range;
+  bool atom = false;
+  // Its name in the outputs: "right_shoulder.z", "right.A2".
+  std::string Label() const {
+    return joint + "." + (atom ? "A" + std::to_string(component) : std::string(1, "xyz"[component]));
+  }
 };
 struct PoseAxis {
-  std::map<std::string, Eigen::Vector3d> fixed;  // every listed joint's components, ranges at their `from`
+  bool atoms = false;                            // the space: atoms' weights, else joint rotations
+  std::map<std::string, Eigen::Vector3d> fixed;  // joints: every listed joint's components, ranges at their `from`
+  std::map<std::string, std::array<double, 5>> weights;  // atoms: per listed arm, A0..A4, ranges at their `from`
   std::vector<PoseDim> dims;                     // the ranged components
   double move_s = 1.0, hold_s = 2.0;
 };

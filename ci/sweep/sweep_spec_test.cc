@@ -17,6 +17,9 @@
 #include "sim/sensor/sensor_model.h"
 #include "sim/sequence/render_job.h"
 #include "sim/motion/keyframes.h"
+#include "sim/motion/motion_test_util.h"
+#include "sim/motion/session.h"
+#include "sim/scene/scene.h"
 
 namespace irbench {
 namespace {
@@ -193,7 +196,7 @@ TEST(SweepSpecTest, PosePointIsAKeyframeMotionHoldingItsAngles) {
   const auto& dims = std::get<PoseAxis>(spec.axes[0].axis).dims;
   ASSERT_EQ(p.at[0].pose.size(), 3u);
   std::map<std::string, double> angle;  // "right_shoulder.z" -> degrees
-  for (size_t d = 0; d < dims.size(); ++d) angle[dims[d].joint + "." + "xyz"[dims[d].component]] = p.at[0].pose[d];
+  for (size_t d = 0; d < dims.size(); ++d) angle[dims[d].Label()] = p.at[0].pose[d];
   ASSERT_EQ(angle.size(), 3u);
   EXPECT_GE(angle["right_shoulder.z"], 20.0);
   EXPECT_LE(angle["right_shoulder.z"], 150.0);
@@ -217,6 +220,84 @@ TEST(SweepSpecTest, PosePointIsAKeyframeMotionHoldingItsAngles) {
     ADD_FAILURE() << "accepted an unknown joint";
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "axes[0].joints.right_knuckle");
+  }
+}
+
+// A pose in the atoms' space: a grid over the listed weights, each point's
+// motion a session of the library's `posture` with the point's weights (an
+// arm whose weights are all 0 rests), which the motion reader plays as the
+// library plays `posture` with those weights.
+TEST(SweepSpecTest, AtomPosePointIsAPostureSessionWithItsWeights) {
+  const SweepSpec spec = LoadSweepSpec(Write("atoms.json", R"({"format": "irbench.sweep/1", "name": "a",
+    "base": {"rig": "theater4", "avatar": "p3"},
+    "axes": [{"pose": "arms", "move_s": 0.5, "hold_s": 1.5,
+              "atoms": {"right": {"A1": {"from": 0, "to": 1, "steps": 3}, "A3": 0.5},
+                        "left": {"A2": {"from": 0, "to": 0.6, "steps": 2}}}}]})"));
+  ASSERT_EQ(PointCount(spec), 6);
+  const auto& pose = std::get<PoseAxis>(spec.axes[0].axis);
+  ASSERT_TRUE(pose.atoms);
+  ASSERT_EQ(pose.dims.size(), 2u);
+  std::set<std::pair<double, double>> seen;
+  for (int i = 0; i < 6; ++i) {
+    const SweepPoint p = PointAt(spec, i);
+    std::map<std::string, double> w;
+    for (size_t d = 0; d < pose.dims.size(); ++d) w[pose.dims[d].Label()] = p.at[0].pose[d];
+    seen.insert({w["right.A1"], w["left.A2"]});
+    const Scenario sc = PointScenario(spec, p, Dir() / "atoms_out");
+    const nlohmann::json file = nlohmann::json::parse(std::ifstream(sc.render.motion));
+    EXPECT_EQ(file["format"], "irbench.session/1");
+    ASSERT_EQ(file["items"].size(), 1u);
+    const nlohmann::json& item = file["items"][0];
+    EXPECT_EQ(item["motion"], "posture");
+    EXPECT_EQ(item["right"]["A3"], 0.5);
+    if (w["right.A1"] > 0) {
+      EXPECT_DOUBLE_EQ(item["right"]["A1"].get<double>(), w["right.A1"]);
+    } else {
+      EXPECT_FALSE(item["right"].contains("A1"));
+    }
+    if (w["left.A2"] > 0) {
+      EXPECT_DOUBLE_EQ(item["left"]["A2"].get<double>(), w["left.A2"]);
+    } else {
+      EXPECT_EQ(item["left"], "A0");
+    }
+    // Played by the motion reader as the library plays `posture`.
+    const Avatar avatar = irbench::testing::Person("p3");
+    const Scene scene = LoadScene(fs::path(IRBENCH_SOURCE_DIR) / "scenes" / "theater.json");
+    MotionContext a{&avatar, &scene, StyleFor("p3", 1), {}}, b = a;
+    const MotionPtr played = ResolveMotion(sc.render.motion, a, "--motion").motion;
+    nlohmann::json params = {{"move_s", 0.5}, {"hold_s", 1.5}, {"right", {{"A1", w["right.A1"]}, {"A3", 0.5}}},
+                             {"left", {{"A2", w["left.A2"]}}}};
+    const MotionPtr library = BuildLibraryMotion("posture", params, b);
+    EXPECT_NEAR(played->Duration(), library->Duration(), 1e-9);
+    const double t = 1.2 / a.style.tempo;
+    const JointTransforms x = ForwardKinematics(avatar.skeleton, played->At(t));
+    const JointTransforms y = ForwardKinematics(avatar.skeleton, library->At(t));
+    for (const int j : {kRightWrist, kLeftWrist}) {
+      EXPECT_LT((x[j].translation() - y[j].translation()).norm(), 1e-9) << i;
+    }
+  }
+  EXPECT_EQ(seen.size(), 6u);
+  // Weights out of 0..1, unknown atoms and arms, and both spaces at once are refused naming the field.
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"({"right": {"A1": {"from": 0, "to": 1.5, "steps": 2}}})", "axes[0].atoms.right.A1"},
+      {R"({"right": {"A5": {"from": 0, "to": 1, "steps": 2}}})", "axes[0].atoms.right.A5"},
+      {R"({"middle": {"A1": {"from": 0, "to": 1, "steps": 2}}})", "axes[0].atoms.middle"},
+      {R"({"right": {"A1": 0.5}})", "axes[0].atoms"}};
+  for (const auto& [atoms, field] : bad) {
+    try {
+      LoadSweepSpec(Write("atoms_bad.json", R"({"format": "irbench.sweep/1", "name": "a", "base": {},
+        "axes": [{"pose": "arms", "atoms": )" + atoms + "}]}"));
+      ADD_FAILURE() << atoms;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), field) << atoms;
+    }
+  }
+  try {
+    LoadSweepSpec(Write("atoms_bad.json", R"({"format": "irbench.sweep/1", "name": "a", "base": {},
+      "axes": [{"pose": "arms", "atoms": {"right": {"A1": 1}}, "joints": {"right_elbow": [0, 0, 0]}}]})"));
+    ADD_FAILURE() << "accepted both spaces";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "axes[0]");
   }
 }
 

@@ -478,12 +478,51 @@ int ParseAtom(const std::string& name, Builder& b, const std::string& field) {
                 "A4 diagonal down)");
 }
 
+// One arm of `posture`: an atom's name, or atoms' weights {"A1": 0.5,
+// "A3": 0.5} (thesis 5.1.1's decomposition read the other way: the rest
+// posture A0 plus each weight times its atom's departure from it). The
+// shoulder's rotation is the weighted mean of the atoms' rotations (their
+// quaternions summed, each on the rest's side, and normalised; for two atoms
+// the slerp between them), the elbow's angle the weighted mean; A0 takes
+// what the weights leave of 1, and weights summing over 1 are scaled to 1.
+ArmPose PostureArm(const nlohmann::json& params, const char* field, int side, Builder& b) {
+  if (!params.is_object() || !params.contains(field) || params[field].is_null()) return Atom(0, side, b.style());
+  const nlohmann::json& v = params[field];
+  if (v.is_string()) return Atom(ParseAtom(v.get<std::string>(), b, field), side, b.style());
+  if (!v.is_object() || v.empty()) b.Fail(field, "must be an atom (A0..A4) or an object of atoms' weights");
+  double weights[5] = {0, 0, 0, 0, 0}, sum = 0;
+  for (const auto& [name, w] : v.items()) {
+    const int atom = ParseAtom(name, b, std::string(field) + "." + name);
+    if (!w.is_number() || !std::isfinite(w.get<double>()) || w.get<double>() < 0 || w.get<double>() > 1) {
+      b.Fail(std::string(field) + "." + name, "a weight must be a number in 0..1");
+    }
+    weights[atom] += w.get<double>();
+    sum += w.get<double>();
+  }
+  weights[0] += std::max(0.0, 1.0 - sum);
+  const ArmPose rest = Atom(0, side, b.style());
+  Eigen::Vector4d q = Eigen::Vector4d::Zero();
+  double elbow = 0, total = 0;
+  for (int atom = 0; atom <= 4; ++atom) {
+    if (weights[atom] <= 0) continue;
+    const ArmPose a = Atom(atom, side, b.style());
+    const double sign = a.shoulder.coeffs().dot(rest.shoulder.coeffs()) < 0 ? -1 : 1;
+    q += sign * weights[atom] * a.shoulder.coeffs();
+    elbow += weights[atom] * a.elbow_deg;
+    total += weights[atom];
+  }
+  ArmPose arm;
+  arm.shoulder = Eigen::Quaterniond(q.normalized());
+  arm.elbow_deg = elbow / total;
+  return arm;
+}
+
 MotionPtr Posture(const nlohmann::json& params, Builder& b) {
-  const int right = ParseAtom(StringParam(params, "right", "A0", b), b, "right");
-  const int left = ParseAtom(StringParam(params, "left", "A0", b), b, "left");
+  const ArmPose right = PostureArm(params, "right", 1, b), left = PostureArm(params, "left", -1, b);
+  const double move = Param(params, "move_s", 1.0, b, 0.1, 60.0);
   const double hold = Param(params, "hold_s", 1.5, b, 0.0, 60.0);
   std::vector<ArmKey> keys = {{0.0, b.Rest(1), b.Rest(-1)}};
-  keys.push_back({b.T(1.0), Atom(right, 1, b.style()), Atom(left, -1, b.style())});
+  keys.push_back({b.T(move), right, left});
   keys.push_back({keys.back().t + b.T(hold), keys.back().right, keys.back().left});
   keys.push_back({keys.back().t + b.T(1.0), b.Rest(1), b.Rest(-1)});
   return b.Standing("posture", keys, {});
@@ -741,7 +780,7 @@ std::vector<std::pair<std::string, std::string>> LibraryMotions() {
       {"flap_one", "gesture 5: one arm flaps (cycles)"},
       {"point_diagonal_both", "gesture 6: both arms point diagonally, up-out and down-out"},
       {"point", "point at a named screen target (target, side, hold_s)"},
-      {"posture", "an atom posture per arm, held (right, left: A0..A4; hold_s)"},
+      {"posture", "an atom posture per arm, or a blend of atoms, held (right, left: A0..A4 or {\"A1\": w, ...}; move_s, hold_s)"},
       {"atom_tour", "every two-arm atom combination in turn (15 postures)"},
       {"posture_candidates", "one arm held in each of 30 candidate postures for atom selection (side, hold_s)"},
       {"story", "natural story-telling hand motions covering the nine motion labels"},
@@ -823,7 +862,7 @@ MotionPtr BuildLibraryMotion(const std::string& name, const nlohmann::json& para
     return PointAt(params, b);
   }
   if (name == "posture") {
-    CheckKeys(params, {"right", "left", "hold_s"}, b);
+    CheckKeys(params, {"right", "left", "move_s", "hold_s"}, b);
     return Posture(params, b);
   }
   if (name == "atom_tour") {

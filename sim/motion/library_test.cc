@@ -217,6 +217,58 @@ TEST(LibraryTest, PostureCandidatesHoldThirtyDistinctOneArmPostures) {
   }
 }
 
+// `posture` with atoms' weights: one atom at weight 1 is that atom, no
+// weight is the rest posture, A1 and A3 half each hold the upper arm halfway
+// between their elevations (0 and 45 degrees: the slerp between two
+// rotations about the same axis), weights over 1 are scaled to 1, and the
+// hold lasts `hold_s` after `move_s`.
+TEST(LibraryTest, PostureBlendsAtomsByWeight) {
+  const Avatar avatar = Person("p3");
+  const auto held = [&](const nlohmann::json& params) {
+    MotionContext ctx{&avatar, &Theater(), StyleFor("p3", 2), {}};
+    const MotionPtr m = BuildLibraryMotion("posture", params, ctx);
+    return ForwardKinematics(avatar.skeleton, m->At(1.6));
+  };
+  // The right upper arm's elevation (degrees above level) and the wrist.
+  const auto elevation = [](const JointTransforms& fk) {
+    const Eigen::Vector3d d = fk[kRightElbow].translation() - fk[kRightShoulder].translation();
+    return std::asin(d.normalized().z()) * 180 / M_PI;
+  };
+  const auto wrist = [](const JointTransforms& fk) { return fk[kRightWrist].translation(); };
+  EXPECT_LT((wrist(held({{"right", {{"A3", 1.0}}}})) - wrist(held({{"right", "A3"}}))).norm(), 1e-9);
+  EXPECT_LT((wrist(held({{"right", {{"A2", 0.0}}}})) - wrist(held({{"right", "A0"}}))).norm(), 1e-9);
+  EXPECT_LT((wrist(held({{"right", {{"A1", 1.0}, {"A3", 1.0}}}})) -
+             wrist(held({{"right", {{"A1", 0.5}, {"A3", 0.5}}}})))
+                .norm(),
+            1e-9);
+  const double a1 = elevation(held({{"right", "A1"}})), a3 = elevation(held({{"right", "A3"}}));
+  EXPECT_NEAR(a1, 0, 3);
+  EXPECT_NEAR(a3, 45, 3);
+  EXPECT_NEAR(elevation(held({{"right", {{"A1", 0.5}, {"A3", 0.5}}}})), 0.5 * (a1 + a3), 0.5);
+  // A quarter of A2 (overhead) from the rest: the arm between the two, nearer the rest.
+  const double rest = elevation(held({{"right", "A0"}})), a2 = elevation(held({{"right", "A2"}}));
+  const double quarter = elevation(held({{"right", {{"A2", 0.25}}}}));
+  EXPECT_GT(quarter, rest + 10);
+  EXPECT_LT(quarter, 0.5 * (rest + a2));
+  MotionContext ctx{&avatar, &Theater(), StyleFor("p3", 2), {}};
+  const MotionPtr m = BuildLibraryMotion("posture", {{"right", {{"A1", 1.0}}}, {"move_s", 0.5}, {"hold_s", 3.0}}, ctx);
+  const double tempo = ctx.style.tempo;
+  EXPECT_NEAR(m->Duration(), BuildLibraryMotion("posture", {{"right", "A1"}}, ctx)->Duration() + 1.0 / tempo, 0.3);
+  const JointTransforms a = ForwardKinematics(avatar.skeleton, m->At(0.55 / tempo));
+  const JointTransforms b = ForwardKinematics(avatar.skeleton, m->At(3.45 / tempo));
+  EXPECT_LT((wrist(a) - wrist(b)).norm(), 0.02);
+  for (const nlohmann::json& bad : {nlohmann::json{{"right", {{"A7", 0.5}}}}, nlohmann::json{{"right", {{"A1", -0.1}}}},
+                                    nlohmann::json{{"right", {{"A1", 1.5}}}}, nlohmann::json{{"right", {{"A1", "x"}}}},
+                                    nlohmann::json{{"left", nlohmann::json::object()}}, nlohmann::json{{"left", 3}}}) {
+    try {
+      BuildLibraryMotion("posture", bad, ctx);
+      ADD_FAILURE() << bad.dump();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.begin().key()), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(LibraryTest, StyleOverridesAreCheckedAndApplied) {
   const MotionStyle st = StyleFor("p1", 1, {{"tempo", 1.5}, {"handedness", "left"}}, "avatars/x.json");
   EXPECT_EQ(st.tempo, 1.5);
