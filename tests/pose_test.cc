@@ -282,11 +282,15 @@ TEST(PoseTracker, ThickensTheArmsToTheAxisPointsDiameters) {
 // height are each configured within 1 cm of their own after standing at rest
 // (the arms' axis points lost against the body) and then pointing forward;
 // arms held out sideways (no crossing) measure nothing, and the fixed
-// proportion stays.
+// proportion stays. The model's arm points lie on its bones, so the girth's
+// bias is off (shoulder_girth_bias_m 0) but in the last case, which takes
+// it off the crossings.
 TEST(PoseTracker, ConfiguresTheShoulderWidthFromStraightArms) {
   const std::vector<Camera> cams = PinholeRig();
-  for (const double width : {0.9, 1.14}) {
+  for (const double width : {0.9, 1.14, 1.0}) {
+    const bool biased = width == 1.0;
     for (const bool sideways : {false, true}) {
+      if (biased && sideways) continue;
       const BodyShape shape = BodyShape::FromHeight(1.75, 1.0, 1.0, width);
       const double yaw = 0.3;
       const BodyPose rest = StandingPose(shape, Vector2d(0.1, 0.2), yaw);
@@ -299,6 +303,8 @@ TEST(PoseTracker, ConfiguresTheShoulderWidthFromStraightArms) {
       }
       PoseTrackerOptions options;
       options.seed = 4;
+      options.shoulder_girth_bias_m = biased ? 0.05 : 0.0;
+      options.shoulder_bias_girth = 0.9;
       PoseTracker tracker(cams, {}, options);
       PoseEstimate e;
       for (int f = 0; f < 50; ++f) {
@@ -311,9 +317,11 @@ TEST(PoseTracker, ConfiguresTheShoulderWidthFromStraightArms) {
           EXPECT_EQ(e.shape.shoulder_width, 1.0) << "no arm points, no measurement";
         }
       }
-      const double expected = sideways ? 0.105 * e.shape.height_m : shape.shoulder_offset_m;
+      const double bias = biased ? 0.05 * (std::clamp(e.shape.girth, 1.2, 1.8) - 0.9) : 0.0;
+      const double expected = sideways ? 0.105 * e.shape.height_m : shape.shoulder_offset_m - bias;
+      if (biased) EXPECT_GE(bias, 0.014);
       EXPECT_NEAR(2 * e.shape.shoulder_offset_m, 2 * expected, 0.01) << width << (sideways ? " sideways" : "");
-      if (!sideways) {
+      if (!sideways && !biased) {
         const PosedBody body = PoseBody(shape, held);
         EXPECT_LT((e.body.joints[kModelRightShoulder] - body.joints[kModelRightShoulder]).norm(), 0.03) << width;
         EXPECT_LT((e.body.joints[kModelLeftShoulder] - body.joints[kModelLeftShoulder]).norm(), 0.03) << width;
@@ -351,7 +359,7 @@ TEST(PoseTracker, ShoulderOffsetFromArmIsWhereAStraightArmCrossesTheShoulders) {
   EXPECT_FALSE(offset(bent));
 }
 
-TEST(PoseTracker, ArmThicknessOptionsAreChecked) {
+TEST(PoseTracker, ArmThicknessAndShoulderOptionsAreChecked) {
   PoseTrackerOptions options;
   EXPECT_NO_THROW(options.Check());
   options.arm_thickness_frames = 0;  // off
@@ -362,7 +370,10 @@ TEST(PoseTracker, ArmThicknessOptionsAreChecked) {
            [](PoseTrackerOptions& o) { o.arm_thickness_frames = -1; },
            [](PoseTrackerOptions& o) { o.arm_thickness_min_points = 0; },
            [](PoseTrackerOptions& o) { o.arm_reference_diameter = 0; },
-           [](PoseTrackerOptions& o) { o.max_arm_thickness = 0.9; }}) {
+           [](PoseTrackerOptions& o) { o.max_arm_thickness = 0.9; },
+           [](PoseTrackerOptions& o) { o.shoulder_girth_bias_m = -0.01; },
+           [](PoseTrackerOptions& o) { o.shoulder_girth_bias_m = std::nan(""); },
+           [](PoseTrackerOptions& o) { o.shoulder_bias_girth = 0.1; }}) {
     PoseTrackerOptions o;
     bad(o);
     EXPECT_THROW(o.Check(), InputError);

@@ -189,7 +189,11 @@ void BodyCalibration::MeasureShoulderWidth(bool tracking, const PosedBody& body,
     std::sort(sorted.begin(), sorted.end());
     const size_t n = sorted.size();
     const double spread = sorted[(3 * n) / 4] - sorted[n / 4];
-    const double width = spread <= options_.shoulder_max_spread_m ? sorted[n / 2] / expected : 1.0;  // the median
+    // The crossings lie outward of the joints by about 4.5 cm per unit of
+    // girth above 1.26 (docs/tracker.md).
+    const double bias = options_.shoulder_girth_bias_m * (std::clamp(shape->girth, 1.2, 1.8) - options_.shoulder_bias_girth);
+    const double width =
+        spread <= options_.shoulder_max_spread_m ? (sorted[n / 2] - bias) / expected : 1.0;  // the median
     if (width != shoulder_width_) {
       shoulder_width_ = width;
       *shape = ShapeFor(shape->height_m, shape->girth);

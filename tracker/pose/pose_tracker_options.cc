@@ -80,6 +80,12 @@ void PoseTrackerOptions::Check() const {
   if (shoulder_min_samples < 1) throw InputError("", "pose.shoulder_min_samples", "must be at least 1");
   if (!(shoulder_max_spread_m > 0))
     throw InputError("", "pose.shoulder_max_spread_m", "must be positive");
+  if (!(shoulder_girth_bias_m >= 0 && shoulder_girth_bias_m <= 0.2)) {
+    throw InputError("", "pose.shoulder_girth_bias_m", "must be in 0..0.2 m");
+  }
+  if (!(shoulder_bias_girth >= 0.5 && shoulder_bias_girth <= 3)) {
+    throw InputError("", "pose.shoulder_bias_girth", "must be in 0.5..3");
+  }
   if (!(walk_memory_s >= 0)) throw InputError("", "pose.walk_memory_s", "must be non-negative");
 }
 

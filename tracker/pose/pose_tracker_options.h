@@ -225,12 +225,18 @@ struct PoseTrackerOptions {
   // the median of the first shoulder_samples arm-frames' measurements (0
   // turns it off), once shoulder_min_samples are in and their interquartile
   // range (metres, each shoulder's distance from the midline) is at most
-  // shoulder_max_spread_m; the fixed proportion otherwise.
+  // shoulder_max_spread_m; the fixed proportion otherwise. The median
+  // less shoulder_girth_bias_m times the measured girth's excess over
+  // shoulder_bias_girth (the girth taken within 1.2-1.8): a straight arm's
+  // axis points cross the shoulders' line outward of the joint, the more so
+  // the broader the body (docs/tracker.md, "Shoulder width").
   // false: the fixed proportion always (irbench track --fixed-shoulders).
   bool configure_shoulders = true;
   int shoulder_samples = 240;
   int shoulder_min_samples = 40;
   double shoulder_max_spread_m = 0.03;
+  double shoulder_girth_bias_m = 0.045;
+  double shoulder_bias_girth = 1.26;
   void Check() const;  // throws InputError naming the field
 };
 
