@@ -1,5 +1,6 @@
 #include "ci/sweep/sweep_pose.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -63,6 +64,7 @@ PoseAxis ReadPoseAxis(const JsonNode& a, bool grid) {
   if (!(pose.hold_s >= 0.1 && pose.hold_s <= 600)) a["hold_s"].Fail("must be in 0.1..600 s");
   if (a.Has("joints") == a.Has("atoms")) a.Fail("give either `joints` (rotations) or `atoms` (the atoms' weights)");
   pose.atoms = a.Has("atoms");
+  if (pose.atoms && pose.hold_s > 60) a["hold_s"].Fail("must be in 0.1..60 s for atoms (the library's `posture`)");
   if (pose.atoms) {
     const JsonNode arms = a["atoms"];
     if (arms.Keys().empty()) arms.Fail("no arms");
@@ -107,7 +109,10 @@ void WritePoseMotion(const PoseAxis& pose, const std::vector<double>& values, co
     // A session of the library's `posture` motion, so that the rest posture
     // and the tempo are the person's own.
     std::map<std::string, std::array<double, 5>> weights = pose.weights;
-    for (size_t d = 0; d < pose.dims.size(); ++d) weights[pose.dims[d].joint][pose.dims[d].component] = values[d];
+    // A grid's last step may land a rounding step beyond its `to`.
+    for (size_t d = 0; d < pose.dims.size(); ++d) {
+      weights[pose.dims[d].joint][pose.dims[d].component] = std::clamp(values[d], 0.0, 1.0);
+    }
     nlohmann::json item = {{"motion", "posture"}, {"move_s", pose.move_s}, {"hold_s", pose.hold_s}};
     for (const auto& [arm, w] : weights) {
       item[arm] = nlohmann::json::object();

@@ -282,7 +282,8 @@ TEST(SweepSpecTest, AtomPosePointIsAPostureSessionWithItsWeights) {
       {R"({"right": {"A1": {"from": 0, "to": 1.5, "steps": 2}}})", "axes[0].atoms.right.A1"},
       {R"({"right": {"A5": {"from": 0, "to": 1, "steps": 2}}})", "axes[0].atoms.right.A5"},
       {R"({"middle": {"A1": {"from": 0, "to": 1, "steps": 2}}})", "axes[0].atoms.middle"},
-      {R"({"right": {"A1": 0.5}})", "axes[0].atoms"}};
+      {R"({"right": {"A1": 0.5}})", "axes[0].atoms"},
+      {R"({"right": {"A1": {"from": 0, "to": 1, "steps": 2}}}, "hold_s": 120)", "axes[0].hold_s"}};
   for (const auto& [atoms, field] : bad) {
     try {
       LoadSweepSpec(Write("atoms_bad.json", R"({"format": "irbench.sweep/1", "name": "a", "base": {},

@@ -482,8 +482,9 @@ int ParseAtom(const std::string& name, Builder& b, const std::string& field) {
 // "A3": 0.5} (thesis 5.1.1's decomposition read the other way: the rest
 // posture A0 plus each weight times its atom's departure from it). The
 // shoulder's rotation is the weighted mean of the atoms' rotations (their
-// quaternions summed, each on the rest's side, and normalised; for two atoms
-// the slerp between them), the elbow's angle the weighted mean; A0 takes
+// quaternions summed, each on the rest's side, and normalised: for two atoms
+// a point on the slerp's arc, the midpoint at equal weights), the elbow's
+// angle the weighted mean; A0 takes
 // what the weights leave of 1, and weights summing over 1 are scaled to 1.
 ArmPose PostureArm(const nlohmann::json& params, const char* field, int side, Builder& b) {
   if (!params.is_object() || !params.contains(field) || params[field].is_null()) return Atom(0, side, b.style());

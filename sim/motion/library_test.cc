@@ -257,14 +257,18 @@ TEST(LibraryTest, PostureBlendsAtomsByWeight) {
   const JointTransforms a = ForwardKinematics(avatar.skeleton, m->At(0.55 / tempo));
   const JointTransforms b = ForwardKinematics(avatar.skeleton, m->At(3.45 / tempo));
   EXPECT_LT((wrist(a) - wrist(b)).norm(), 0.02);
-  for (const nlohmann::json& bad : {nlohmann::json{{"right", {{"A7", 0.5}}}}, nlohmann::json{{"right", {{"A1", -0.1}}}},
-                                    nlohmann::json{{"right", {{"A1", 1.5}}}}, nlohmann::json{{"right", {{"A1", "x"}}}},
-                                    nlohmann::json{{"left", nlohmann::json::object()}}, nlohmann::json{{"left", 3}}}) {
+  const std::vector<std::pair<nlohmann::json, std::string>> bad = {
+      {{{"right", {{"A7", 0.5}}}}, "right.A7"}, {{{"right", {{"A1", -0.1}}}}, "right.A1"},
+      {{{"right", {{"A1", 1.5}}}}, "right.A1"}, {{{"right", {{"A1", "x"}}}}, "right.A1"},
+      {{{"left", nlohmann::json::object()}}, "left"}, {{{"left", 3}}, "left"}};
+  for (const auto& [params, field] : bad) {
     try {
-      BuildLibraryMotion("posture", bad, ctx);
-      ADD_FAILURE() << bad.dump();
+      BuildLibraryMotion("posture", params, ctx);
+      ADD_FAILURE() << params.dump();
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(bad.begin().key()), std::string::npos) << e.what();
+      const std::string f = e.field();
+      EXPECT_EQ(f.substr(f.size() - std::min(f.size(), field.size())), field) << e.what();
+      EXPECT_TRUE(f.size() == field.size() || f[f.size() - field.size() - 1] == '.') << f;
     }
   }
 }

@@ -190,7 +190,9 @@ void BodyCalibration::MeasureShoulderWidth(bool tracking, const PosedBody& body,
     const size_t n = sorted.size();
     const double spread = sorted[(3 * n) / 4] - sorted[n / 4];
     // The crossings lie outward of the joints by about 4.5 cm per unit of
-    // girth above 1.26 (docs/tracker.md).
+    // girth above 1.26 (docs/tracker.md). Taken at the girth of the frame
+    // that completes a measurement; the girth is measured over the first
+    // frames, usually before the arms are held out.
     const double bias = options_.shoulder_girth_bias_m * (std::clamp(shape->girth, 1.2, 1.8) - options_.shoulder_bias_girth);
     const double width =
         spread <= options_.shoulder_max_spread_m ? (sorted[n / 2] - bias) / expected : 1.0;  // the median
