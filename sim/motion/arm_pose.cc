@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 
 namespace irbench {
 namespace {
 constexpr double kArmDeg = M_PI / 180.0;
 }  // namespace
-
 
 Eigen::Vector3d BindArmDir(int side) { return Eigen::Vector3d(side, 0, 0); }
 
@@ -81,9 +79,9 @@ ArmPose Atom(int atom, int side, const MotionStyle& style) {
   }
 }
 
-ArmPose AtomBlend(const double (&weights_in)[5], double sum, int side, const MotionStyle& style) {
-  double weights[5];
-  std::copy(std::begin(weights_in), std::end(weights_in), weights);
+ArmPose AtomBlend(std::array<double, 5> weights, int side, const MotionStyle& style) {
+  double sum = 0;
+  for (const double w : weights) sum += w;
   weights[0] += std::max(0.0, 1.0 - sum);
   const ArmPose rest = Atom(0, side, style);
   Eigen::Vector4d q = Eigen::Vector4d::Zero();

@@ -4,6 +4,7 @@
 // (docs/motion.md) and blends of them.
 
 #include <Eigen/Geometry>
+#include <array>
 
 #include "sim/body/skeleton.h"
 #include "sim/motion/library.h"
@@ -47,8 +48,8 @@ ArmPose Atom(int atom, int side, const MotionStyle& style);
 // weighted mean of the atoms' rotations (their quaternions summed, each on
 // the rest's side, and normalised: for two atoms a point on the slerp's arc,
 // the midpoint at equal weights), the elbow's angle the weighted mean; A0
-// takes what the weights (summing to `sum`) leave of 1, and weights summing
-// over 1 are scaled to 1.
-ArmPose AtomBlend(const double (&weights)[5], double sum, int side, const MotionStyle& style);
+// takes what the weights (A0..A4) leave of 1, and weights summing over 1
+// are scaled to 1.
+ArmPose AtomBlend(std::array<double, 5> weights, int side, const MotionStyle& style);
 
 }  // namespace irbench

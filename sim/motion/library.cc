@@ -29,7 +29,6 @@ double Uniform(uint64_t& state) {
   return (z >> 11) * (1.0 / 9007199254740992.0);
 }
 
-
 struct BodyPose {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   double heading_deg = 0;
@@ -276,7 +275,6 @@ int SideParam(const nlohmann::json& params, Builder& b) {
 
 const char* SideName(int side) { return side > 0 ? "right" : "left"; }
 
-
 void CheckKeys(const nlohmann::json& params, const std::vector<std::string>& allowed, Builder& b) {
   if (params.is_null()) return;
   if (!params.is_object()) b.Fail("", "parameters must be an object");
@@ -409,16 +407,15 @@ ArmPose PostureArm(const nlohmann::json& params, const char* field, int side, Bu
   const nlohmann::json& v = params[field];
   if (v.is_string()) return Atom(ParseAtom(v.get<std::string>(), b, field), side, b.style());
   if (!v.is_object() || v.empty()) b.Fail(field, "must be an atom (A0..A4) or an object of atoms' weights");
-  double weights[5] = {0, 0, 0, 0, 0}, sum = 0;
+  std::array<double, 5> weights{};
   for (const auto& [name, w] : v.items()) {
     const int atom = ParseAtom(name, b, std::string(field) + "." + name);
     if (!w.is_number() || !std::isfinite(w.get<double>()) || w.get<double>() < 0 || w.get<double>() > 1) {
       b.Fail(std::string(field) + "." + name, "a weight must be a number in 0..1");
     }
     weights[atom] += w.get<double>();
-    sum += w.get<double>();
   }
-  return AtomBlend(weights, sum, side, b.style());
+  return AtomBlend(weights, side, b.style());
 }
 
 MotionPtr Posture(const nlohmann::json& params, Builder& b) {
