@@ -6,6 +6,7 @@
 
 #include "common/atomic_file.h"
 #include "sim/body/skeleton.h"
+#include "sim/motion/library.h"
 
 namespace irbench {
 namespace {
@@ -74,10 +75,9 @@ PoseAxis ReadPoseAxis(const JsonNode& a, bool grid) {
       if (w.Keys().empty()) w.Fail("no atoms");
       std::array<double, 5> weights{};
       for (const std::string& name : w.Keys()) {
-        if (name.size() != 2 || name[0] != 'A' || name[1] < '0' || name[1] > '4') {
-          w[name].Fail("unknown atom (A0 rest, A1 horizontal, A2 overhead, A3 diagonal up, A4 diagonal down)");
-        }
-        PoseDim dim{arm, name[1] - '0', {}, true};
+        const int atom = PostureAtomIndex(name);
+        if (atom < 0) w[name].Fail(std::string("unknown atom (") + kPostureAtomNames + ")");
+        PoseDim dim{arm, atom, {}, true};
         weights[dim.component] = ReadComponent(w[name], dim, 0, 1, "", grid, &pose);
       }
       pose.weights[arm] = weights;

@@ -68,6 +68,13 @@ ArmPose ArmReach(int side, const Skeleton& sk, const Eigen::Vector3d& wrist, con
   return ArmFromDirections(side, d_u, to * r - elbow);
 }
 
+int PostureAtomIndex(const std::string& name) {
+  if (name.size() == 2 && name[0] == 'A' && name[1] >= '0' && name[1] <= '4') return name[1] - '0';
+  return -1;
+}
+
+const char* const kPostureAtomNames = "A0 rest, A1 horizontal, A2 overhead, A3 diagonal up, A4 diagonal down";
+
 // The five atom postures of one arm (docs/motion.md).
 ArmPose Atom(int atom, int side, const MotionStyle& style) {
   switch (atom) {

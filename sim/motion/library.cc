@@ -395,9 +395,9 @@ MotionPtr Gesture(int id, const nlohmann::json& params, Builder& b) {
 namespace {
 
 int ParseAtom(const std::string& name, Builder& b, const std::string& field) {
-  if (name.size() == 2 && name[0] == 'A' && name[1] >= '0' && name[1] <= '4') return name[1] - '0';
-  b.Fail(field, "unknown atom '" + name + "' (A0 rest, A1 horizontal, A2 overhead, A3 diagonal up, "
-                "A4 diagonal down)");
+  const int atom = PostureAtomIndex(name);
+  if (atom < 0) b.Fail(field, "unknown atom '" + name + "' (" + kPostureAtomNames + ")");
+  return atom;
 }
 
 // One arm of `posture`: an atom's name, or atoms' weights {"A1": 0.5,

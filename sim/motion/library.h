@@ -62,4 +62,9 @@ std::vector<std::pair<std::string, std::string>> LibraryMotions();
 // The six gestures of the thesis (5.3), ids 1..6 in order.
 const std::vector<std::string>& GestureNames();
 
+// The five posture atoms (docs/motion.md) by name: "A0".."A4" give 0..4,
+// any other name -1. kPostureAtomNames lists them for error messages.
+int PostureAtomIndex(const std::string& name);
+extern const char* const kPostureAtomNames;
+
 }  // namespace irbench
